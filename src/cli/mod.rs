@@ -1,0 +1,45 @@
+//! Command-line front end: one file per subcommand. Each subcommand's
+//! `run` returns the process exit code; errors that stop a whole command
+//! are printed here as one line and exit with 1.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod info;
+mod mip;
+mod sample;
+
+/// Texture filtering and mipmap processing.
+#[derive(Parser, Debug)]
+#[command(name = "parvo", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Build mip-mapped textures (EXR, KTX2, DDS, PNG per level).
+    Mip(mip::MipArgs),
+    /// Describe a texture file: format, size, levels, tiling, metadata.
+    Info(info::InfoArgs),
+    /// Sample a texture at queries read from stdin.
+    Sample(sample::SampleArgs),
+}
+
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Mip(a) => mip::run(a),
+        Command::Info(a) => info::run(a),
+        Command::Sample(a) => sample::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("parvo: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}

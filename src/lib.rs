@@ -1,0 +1,49 @@
+//! parvo: texture filtering and mipmap processing.
+//!
+//! # Structure and data flow
+//!
+//! ```text
+//! file / builtin ──▶ Texture (level 0, its storage format)
+//!                      │ mip::build(MipOptions)
+//!                      ▼
+//!                   MipChain (levels in the source format)
+//! ```
+//!
+//! - [`texel`]: formats (1–4 channels; u8, u16, f16, f32; linear or sRGB;
+//!   straight or premultiplied alpha) and the conversions to and from
+//!   linear-light f32 that every filter works in.
+//! - [`texture`]: [`Texture`], an owned level with checked dimensions.
+//! - [`wrap`]: [`WrapMode`] and the one function mapping integer texel
+//!   indices into a level.
+//! - [`builtin`]: procedural textures (`builtin:checker`,
+//!   `builtin:zoneplate`).
+//! - [`mip`]: level sizes, kernels, polyphase weights, the separable
+//!   reference path and the fast box paths, alpha coverage and normal
+//!   renormalisation, the chain builder.
+//!
+//! The library never prints and never panics on bad input: errors are
+//! [`Error`] values, long builds report through a progress callback.
+//!
+//! ```
+//! use parvo::{builtin, mip};
+//! let tex = builtin::load("builtin:checker:64")?;
+//! let chain = mip::build(tex, &mip::MipOptions::with_filter(mip::MipFilter::Kaiser))?;
+//! assert_eq!(chain.len(), 7); // 64, 32, ..., 1
+//! # Ok::<(), parvo::Error>(())
+//! ```
+
+#![deny(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod builtin;
+pub mod error;
+pub mod mip;
+pub mod texel;
+pub mod texture;
+pub mod wrap;
+
+pub use error::{Error, Result};
+pub use mip::{MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
+pub use texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
+pub use texture::Texture;
+pub use wrap::{Wrap, WrapMode};

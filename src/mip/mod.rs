@@ -1,0 +1,405 @@
+//! Mip pyramids: level sizes, downsampling filters, and the chain builder.
+//!
+//! [`build`] turns a level-0 [`Texture`] into a [`MipChain`]. Each level is
+//! computed from the previous one as stored (as GPU drivers and maketx do),
+//! in linear light, then encoded to the source's format:
+//!
+//! 1. Level 0 is checked for NaN/Inf under [`NanPolicy`] (float types).
+//! 2. For each next level, [`level_size`] gives the size; the reduction runs
+//!    on rayon over destination rows. Two tiers:
+//!    - fast paths ([`fast`]) for the 2×2 box of even-sized levels: integer
+//!      arithmetic for u8 (linear and table-driven sRGB), a fused kernel for
+//!      linear f32;
+//!    - the general separable path ([`separable`]) for every filter, type,
+//!      size and wrap mode. It is the reference the fast paths are tested
+//!      against (`tests/mip_fast_paths_match_plain.rs`).
+//! 3. Optional per-level post-processing: alpha-test coverage preservation
+//!    ([`alpha`]) and normal renormalisation ([`normal`]).
+//!
+//! Memory: the general path decodes the source level to f32 once
+//! (4 bytes × channels × texels) unless it is already linear f32; the fast
+//! paths use only a row of scratch per thread.
+
+pub mod alpha;
+pub mod fast;
+pub mod kernel;
+pub mod nan;
+pub mod normal;
+pub mod separable;
+pub mod weights;
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+use crate::texture::Texture;
+use crate::wrap::Wrap;
+
+pub use nan::NanPolicy;
+
+/// Downsampling filter (SPEC.md "Mip levels").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum MipFilter {
+    /// Area-weighted box: 2×2 average, polyphase 3-tap box on odd sizes.
+    #[default]
+    Box,
+    /// Tent, radius 1 (scaled by the reduction).
+    Triangle,
+    /// Kaiser-windowed sinc, width 3, alpha 4 (NVIDIA texture tools).
+    Kaiser,
+    /// Lanczos, three lobes.
+    Lanczos3,
+    /// Mitchell–Netravali, B = C = 1/3.
+    Mitchell,
+}
+
+impl MipFilter {
+    /// Every filter, in a stable order.
+    pub const ALL: [MipFilter; 5] = [
+        MipFilter::Box,
+        MipFilter::Triangle,
+        MipFilter::Kaiser,
+        MipFilter::Lanczos3,
+        MipFilter::Mitchell,
+    ];
+
+    /// The stable name (`box`, `triangle`, `kaiser`, `lanczos3`, `mitchell`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MipFilter::Box => "box",
+            MipFilter::Triangle => "triangle",
+            MipFilter::Kaiser => "kaiser",
+            MipFilter::Lanczos3 => "lanczos3",
+            MipFilter::Mitchell => "mitchell",
+        }
+    }
+
+    /// The kernel behind the filter.
+    pub fn kernel(self) -> Box<dyn kernel::Kernel + Send + Sync> {
+        match self {
+            MipFilter::Box => Box::new(kernel::BoxKernel),
+            MipFilter::Triangle => Box::new(kernel::Triangle),
+            MipFilter::Kaiser => Box::new(kernel::Kaiser::default()),
+            MipFilter::Lanczos3 => Box::new(kernel::Lanczos3),
+            MipFilter::Mitchell => Box::new(kernel::Mitchell::default()),
+        }
+    }
+}
+
+impl fmt::Display for MipFilter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for MipFilter {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        MipFilter::ALL
+            .into_iter()
+            .find(|f| f.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| {
+                Error::parse(
+                    "mip filter",
+                    s,
+                    "expected box, triangle, kaiser, lanczos3 or mitchell",
+                )
+            })
+    }
+}
+
+/// How odd level sizes round (OpenEXR's `RoundingMode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Rounding {
+    /// `floor(size / 2)` (the GPU rule).
+    #[default]
+    Down,
+    /// `ceil(size / 2)`.
+    Up,
+}
+
+impl fmt::Display for Rounding {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Rounding::Down => "down",
+            Rounding::Up => "up",
+        })
+    }
+}
+
+impl FromStr for Rounding {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "down" => Ok(Rounding::Down),
+            "up" => Ok(Rounding::Up),
+            _ => Err(Error::parse("rounding mode", s, "expected down or up")),
+        }
+    }
+}
+
+/// Everything that decides how a chain is built. Comparable and hashable so
+/// it can key caches and fingerprints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MipOptions {
+    /// Downsampling filter. Default: box.
+    pub filter: MipFilter,
+    /// Wrap modes used to resolve taps outside a level. Default: repeat.
+    pub wrap: Wrap,
+    /// Level size rounding. Default: down.
+    pub rounding: Rounding,
+    /// Maximum number of levels including level 0; `None` (default) builds
+    /// the full chain down to 1×1.
+    pub max_levels: Option<u32>,
+    /// Alpha-test coverage preservation with this reference alpha
+    /// (Castaño); `None` (default) leaves alpha as filtered.
+    pub alpha_coverage: Option<f32>,
+    /// Treat RGB as a unit normal (unorm: `2v − 1`) and renormalise every
+    /// level after filtering. Default: false.
+    pub normal_map: bool,
+    /// What to do with NaN/Inf in float input. Default: error.
+    pub nan_policy: NanPolicy,
+    /// Use the fast paths where they apply. Default: true. Turning it off
+    /// forces the plain separable path (used by tests as the reference).
+    pub fast_paths: bool,
+}
+
+impl Default for MipOptions {
+    fn default() -> Self {
+        MipOptions {
+            filter: MipFilter::Box,
+            wrap: Wrap::default(),
+            rounding: Rounding::Down,
+            max_levels: None,
+            alpha_coverage: None,
+            normal_map: false,
+            nan_policy: NanPolicy::Error,
+            fast_paths: true,
+        }
+    }
+}
+
+impl MipOptions {
+    /// Options with the given filter and defaults otherwise.
+    pub fn with_filter(filter: MipFilter) -> Self {
+        MipOptions {
+            filter,
+            ..Default::default()
+        }
+    }
+}
+
+/// Size of level `k` of a `w × h` texture: `max(1, floor(w / 2^k))` (or
+/// `ceil` when rounding up), per axis.
+pub fn level_size(width: u32, height: u32, level: u32, rounding: Rounding) -> (u32, u32) {
+    let f = |n: u32| -> u32 {
+        if level >= 32 {
+            return 1;
+        }
+        let r = match rounding {
+            Rounding::Down => n >> level,
+            Rounding::Up => ((n as u64 + (1u64 << level) - 1) >> level) as u32,
+        };
+        r.max(1)
+    };
+    (f(width), f(height))
+}
+
+/// Number of levels of a full chain: `floor(log2(max(w, h))) + 1` when
+/// rounding down (`ceil` when rounding up), capped by `max_levels`.
+pub fn level_count(width: u32, height: u32, rounding: Rounding, max_levels: Option<u32>) -> u32 {
+    let m = width.max(height).max(1);
+    let full = match rounding {
+        Rounding::Down => 32 - m.leading_zeros(),
+        Rounding::Up => 32 - (m - 1).leading_zeros() + 1,
+    };
+    match max_levels {
+        Some(n) => full.min(n.max(1)),
+        None => full,
+    }
+}
+
+/// Sizes of every level of the chain.
+pub fn level_sizes(
+    width: u32,
+    height: u32,
+    rounding: Rounding,
+    max_levels: Option<u32>,
+) -> Vec<(u32, u32)> {
+    (0..level_count(width, height, rounding, max_levels))
+        .map(|k| level_size(width, height, k, rounding))
+        .collect()
+}
+
+/// Progress of a chain build, reported after each level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Levels finished (level 0 counts as finished once validated).
+    pub levels_done: u32,
+    /// Levels in the chain.
+    pub levels_total: u32,
+    /// Destination texels written so far.
+    pub texels_done: u64,
+    /// Destination texels of all levels after level 0.
+    pub texels_total: u64,
+}
+
+/// A texture and its reduced levels, level 0 first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MipChain {
+    levels: Vec<Texture>,
+    options: MipOptions,
+}
+
+impl MipChain {
+    /// Assemble a chain from existing levels (e.g. read from a file). The
+    /// sizes must follow [`level_size`] for `rounding`.
+    pub fn from_levels(levels: Vec<Texture>, options: MipOptions) -> Result<Self> {
+        let first = levels
+            .first()
+            .ok_or_else(|| Error::InvalidOption("a mip chain needs at least one level".into()))?;
+        let (w, h, fmt) = (first.width(), first.height(), first.format());
+        for (k, l) in levels.iter().enumerate() {
+            let want = level_size(w, h, k as u32, options.rounding);
+            if (l.width(), l.height()) != want || l.format() != fmt {
+                return Err(Error::InvalidOption(format!(
+                    "level {k} is {}x{} {}, expected {}x{} {}",
+                    l.width(),
+                    l.height(),
+                    l.format(),
+                    want.0,
+                    want.1,
+                    fmt
+                )));
+            }
+        }
+        if levels.len() as u32 > level_count(w, h, options.rounding, None) {
+            return Err(Error::InvalidOption(
+                "more levels than the chain can have".into(),
+            ));
+        }
+        Ok(MipChain { levels, options })
+    }
+
+    /// All levels, level 0 first.
+    pub fn levels(&self) -> &[Texture] {
+        &self.levels
+    }
+    /// Level `k`.
+    pub fn level(&self, k: usize) -> Option<&Texture> {
+        self.levels.get(k)
+    }
+    /// Number of levels.
+    pub fn len(&self) -> usize {
+        self.levels.len()
+    }
+    /// Always false: a chain has level 0.
+    pub fn is_empty(&self) -> bool {
+        self.levels.is_empty()
+    }
+    /// The options the chain was built with.
+    pub fn options(&self) -> &MipOptions {
+        &self.options
+    }
+    /// Consume into the levels.
+    pub fn into_levels(self) -> Vec<Texture> {
+        self.levels
+    }
+}
+
+/// Build the full chain of `base` (see the module docs).
+pub fn build(base: Texture, options: &MipOptions) -> Result<MipChain> {
+    build_with_progress(base, options, &mut |_| {})
+}
+
+/// [`build`] with a callback after each level (called on the caller's
+/// thread; the library never prints).
+pub fn build_with_progress(
+    mut base: Texture,
+    options: &MipOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<MipChain> {
+    validate(&base, options)?;
+    nan::apply(&mut base, options.nan_policy)?;
+    let sizes = level_sizes(
+        base.width(),
+        base.height(),
+        options.rounding,
+        options.max_levels,
+    );
+    let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
+    let coverage_ref = options.alpha_coverage;
+    let coverage0 = match (coverage_ref, base.format().alpha_channel()) {
+        (Some(r), Some(_)) => Some(alpha::coverage(&base, r)),
+        _ => None,
+    };
+    let mut p = Progress {
+        levels_done: 1,
+        levels_total: sizes.len() as u32,
+        texels_done: 0,
+        texels_total,
+    };
+    progress(p);
+    let mut levels = Vec::with_capacity(sizes.len());
+    levels.push(base);
+    for &(w, h) in &sizes[1..] {
+        let prev = levels.last().expect("level 0 is present");
+        let mut next = reduce(prev, w, h, options)?;
+        if let (Some(r), Some(c0)) = (coverage_ref, coverage0) {
+            alpha::preserve_coverage(&mut next, r, c0);
+        }
+        if options.normal_map {
+            normal::renormalize(&mut next);
+        }
+        levels.push(next);
+        p.levels_done += 1;
+        p.texels_done += w as u64 * h as u64;
+        progress(p);
+    }
+    Ok(MipChain {
+        levels,
+        options: *options,
+    })
+}
+
+fn validate(base: &Texture, options: &MipOptions) -> Result<()> {
+    if let Some(r) = options.alpha_coverage {
+        if !(r > 0.0 && r < 1.0) {
+            return Err(Error::InvalidOption(format!(
+                "alpha coverage reference {r} must be between 0 and 1 (exclusive)"
+            )));
+        }
+        if !base.format().has_alpha() {
+            return Err(Error::InvalidOption(
+                "alpha coverage needs a texture with an alpha channel".into(),
+            ));
+        }
+    }
+    if options.normal_map && base.channels() < 3 {
+        return Err(Error::InvalidOption(
+            "a normal map needs at least 3 channels".into(),
+        ));
+    }
+    if options.normal_map && base.format().color_space == crate::texel::ColorSpace::Srgb {
+        return Err(Error::InvalidOption(
+            "normal maps hold vectors, not colours: load them as linear".into(),
+        ));
+    }
+    if options.max_levels == Some(0) {
+        return Err(Error::InvalidOption(
+            "the chain needs at least one level".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Reduce one level to `w × h` with the chosen filter (fast path if one
+/// applies, otherwise the separable path).
+pub fn reduce(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result<Texture> {
+    if options.fast_paths {
+        if let Some(t) = fast::try_reduce(src, w, h, options)? {
+            return Ok(t);
+        }
+    }
+    separable::reduce(src, w, h, options)
+}

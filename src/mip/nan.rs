@@ -1,0 +1,131 @@
+//! What to do with NaN and ±Inf in float input.
+//!
+//! Non-finite values poison every level above them (a box of one NaN is
+//! NaN), so level 0 is checked before any filtering. Integer types cannot
+//! hold them and are never scanned.
+
+use std::fmt;
+use std::str::FromStr;
+
+use half::slice::HalfFloatSliceExt;
+
+use crate::error::{Error, Result};
+use crate::texel::Texels;
+use crate::texture::Texture;
+
+/// Policy for non-finite values (NaN, +Inf, −Inf) in float textures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum NanPolicy {
+    /// Refuse with [`Error::NonFinite`] naming the first bad value in
+    /// row-major order. The default: bad data should be seen, not hidden.
+    #[default]
+    Error,
+    /// Replace each non-finite value by 0.
+    Black,
+    /// Replace each non-finite value by the average of the finite values of
+    /// the same channel among its (up to 8) neighbours; 0 if none is finite.
+    Neighbors,
+}
+
+impl fmt::Display for NanPolicy {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            NanPolicy::Error => "error",
+            NanPolicy::Black => "black",
+            NanPolicy::Neighbors => "neighbors",
+        })
+    }
+}
+
+impl FromStr for NanPolicy {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "error" => Ok(NanPolicy::Error),
+            "black" => Ok(NanPolicy::Black),
+            "neighbors" | "neighbours" => Ok(NanPolicy::Neighbors),
+            _ => Err(Error::parse(
+                "NaN policy",
+                s,
+                "expected error, black or neighbors",
+            )),
+        }
+    }
+}
+
+/// Apply `policy` to `tex` in place.
+pub fn apply(tex: &mut Texture, policy: NanPolicy) -> Result<()> {
+    let (w, h, ch) = (tex.width() as usize, tex.height() as usize, tex.channels());
+    let first_bad = |v: &[f32]| v.iter().position(|x| !x.is_finite());
+    match tex.texels_mut() {
+        Texels::F32(v) => {
+            if let Some(i) = first_bad(v) {
+                fix(v, i, w, h, ch, policy)?;
+            }
+        }
+        Texels::F16(v) => {
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                let mut f = v.to_f32_vec();
+                fix(&mut f, i, w, h, ch, policy)?;
+                v.convert_from_f32_slice(&f);
+            }
+        }
+        Texels::U8(_) | Texels::U16(_) => {}
+    }
+    Ok(())
+}
+
+fn fix(
+    v: &mut [f32],
+    first: usize,
+    w: usize,
+    h: usize,
+    ch: usize,
+    policy: NanPolicy,
+) -> Result<()> {
+    match policy {
+        NanPolicy::Error => {
+            let t = first / ch;
+            Err(Error::NonFinite {
+                x: (t % w) as u32,
+                y: (t / w) as u32,
+                channel: (first % ch) as u8,
+                value: v[first],
+            })
+        }
+        NanPolicy::Black => {
+            for x in v.iter_mut().filter(|x| !x.is_finite()) {
+                *x = 0.0;
+            }
+            Ok(())
+        }
+        NanPolicy::Neighbors => {
+            let orig = v.to_vec();
+            for i in (first..v.len()).filter(|&i| !orig[i].is_finite()) {
+                let (t, c) = (i / ch, i % ch);
+                let (x, y) = ((t % w) as isize, (t / w) as isize);
+                let (mut sum, mut n) = (0f64, 0u32);
+                for dy in -1..=1isize {
+                    for dx in -1..=1isize {
+                        let (nx, ny) = (x + dx, y + dy);
+                        if (dx, dy) == (0, 0)
+                            || nx < 0
+                            || ny < 0
+                            || nx >= w as isize
+                            || ny >= h as isize
+                        {
+                            continue;
+                        }
+                        let s = orig[(ny as usize * w + nx as usize) * ch + c];
+                        if s.is_finite() {
+                            sum += s as f64;
+                            n += 1;
+                        }
+                    }
+                }
+                v[i] = if n > 0 { (sum / n as f64) as f32 } else { 0.0 };
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,476 @@
+//! What a texel is: channel count, channel type, colour space and alpha mode,
+//! and the conversions between stored values and linear-light `f32`.
+//!
+//! Every filter in parvo works on linear light. Stored data is decoded once
+//! (u8/u16 normalised, f16 widened, sRGB linearised through tables) and
+//! encoded back with round-to-nearest. The conversions here are the single
+//! home of those rules; fast paths elsewhere are tested against them.
+
+pub mod srgb;
+
+use std::fmt;
+use std::str::FromStr;
+
+use half::f16;
+use half::slice::HalfFloatSliceExt;
+
+use crate::error::{Error, Result};
+
+/// How one channel value is stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum ChannelType {
+    /// 8-bit unsigned normalised: code / 255.
+    #[default]
+    U8,
+    /// 16-bit unsigned normalised: code / 65535.
+    U16,
+    /// IEEE half float.
+    F16,
+    /// IEEE single float.
+    F32,
+}
+
+impl ChannelType {
+    /// Bytes per channel value.
+    pub fn bytes(self) -> usize {
+        match self {
+            ChannelType::U8 => 1,
+            ChannelType::U16 | ChannelType::F16 => 2,
+            ChannelType::F32 => 4,
+        }
+    }
+
+    /// True for the float types, which may hold values outside [0, 1],
+    /// NaN and infinities.
+    pub fn is_float(self) -> bool {
+        matches!(self, ChannelType::F16 | ChannelType::F32)
+    }
+
+    /// Short name: `u8`, `u16`, `f16`, `f32`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ChannelType::U8 => "u8",
+            ChannelType::U16 => "u16",
+            ChannelType::F16 => "f16",
+            ChannelType::F32 => "f32",
+        }
+    }
+}
+
+impl fmt::Display for ChannelType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ChannelType {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Ok(match s.to_ascii_lowercase().as_str() {
+            "u8" => ChannelType::U8,
+            "u16" => ChannelType::U16,
+            "f16" | "half" => ChannelType::F16,
+            "f32" | "float" => ChannelType::F32,
+            _ => {
+                return Err(Error::parse(
+                    "channel type",
+                    s,
+                    "expected u8, u16, f16 or f32",
+                ));
+            }
+        })
+    }
+}
+
+/// Transfer function of the colour channels (alpha is always linear).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum ColorSpace {
+    /// Values are linear light.
+    #[default]
+    Linear,
+    /// Values are sRGB-encoded (IEC 61966-2-1 piecewise curve).
+    Srgb,
+}
+
+impl fmt::Display for ColorSpace {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ColorSpace::Linear => "linear",
+            ColorSpace::Srgb => "srgb",
+        })
+    }
+}
+
+impl FromStr for ColorSpace {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Ok(match s.to_ascii_lowercase().as_str() {
+            "linear" => ColorSpace::Linear,
+            "srgb" => ColorSpace::Srgb,
+            _ => return Err(Error::parse("colour space", s, "expected linear or srgb")),
+        })
+    }
+}
+
+/// How colour relates to alpha in textures that have an alpha channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum AlphaMode {
+    /// Colour is independent of alpha (unassociated). Filters weight colour
+    /// by alpha and divide it back out, so transparent texels do not darken
+    /// their neighbours.
+    #[default]
+    Straight,
+    /// Colour is already multiplied by alpha (associated); filtered as is.
+    Premultiplied,
+}
+
+impl fmt::Display for AlphaMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            AlphaMode::Straight => "straight",
+            AlphaMode::Premultiplied => "premultiplied",
+        })
+    }
+}
+
+impl FromStr for AlphaMode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Ok(match s.to_ascii_lowercase().as_str() {
+            "straight" | "unassociated" => AlphaMode::Straight,
+            "premultiplied" | "associated" => AlphaMode::Premultiplied,
+            _ => {
+                return Err(Error::parse(
+                    "alpha mode",
+                    s,
+                    "expected straight or premultiplied",
+                ));
+            }
+        })
+    }
+}
+
+/// The full description of a texel.
+///
+/// Channel layouts: 1 = grey (or R), 2 = grey + alpha, 3 = RGB, 4 = RGBA.
+/// The alpha channel, when present, is the last one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Format {
+    /// Channels per texel, 1 to 4.
+    pub channels: u8,
+    /// Storage type of each channel.
+    pub channel_type: ChannelType,
+    /// Transfer function of the colour (non-alpha) channels.
+    pub color_space: ColorSpace,
+    /// Alpha convention (ignored without an alpha channel).
+    pub alpha: AlphaMode,
+}
+
+impl Default for Format {
+    /// RGBA8, sRGB, straight alpha: what an ordinary PNG holds.
+    fn default() -> Self {
+        Format::new(4, ChannelType::U8, ColorSpace::Srgb)
+    }
+}
+
+impl Format {
+    /// A format with straight alpha.
+    pub const fn new(channels: u8, channel_type: ChannelType, color_space: ColorSpace) -> Self {
+        Format {
+            channels,
+            channel_type,
+            color_space,
+            alpha: AlphaMode::Straight,
+        }
+    }
+
+    /// Same format with another alpha mode.
+    pub const fn with_alpha(mut self, alpha: AlphaMode) -> Self {
+        self.alpha = alpha;
+        self
+    }
+
+    /// True when the last channel is alpha (2 or 4 channels).
+    pub fn has_alpha(&self) -> bool {
+        self.channels == 2 || self.channels == 4
+    }
+
+    /// Index of the alpha channel, if any.
+    pub fn alpha_channel(&self) -> Option<usize> {
+        self.has_alpha().then(|| self.channels as usize - 1)
+    }
+
+    /// Number of colour (non-alpha) channels.
+    pub fn color_channels(&self) -> usize {
+        self.channels as usize - usize::from(self.has_alpha())
+    }
+
+    /// Bytes per texel.
+    pub fn texel_bytes(&self) -> usize {
+        self.channels as usize * self.channel_type.bytes()
+    }
+
+    pub(crate) fn validate(&self) -> Result<()> {
+        if !(1..=4).contains(&self.channels) {
+            return Err(Error::InvalidOption(format!(
+                "{} channels: parvo supports 1 to 4",
+                self.channels
+            )));
+        }
+        Ok(())
+    }
+
+    /// True when channel `c` is decoded with the sRGB curve.
+    #[inline]
+    pub fn is_srgb_channel(&self, c: usize) -> bool {
+        self.color_space == ColorSpace::Srgb && c < self.color_channels()
+    }
+}
+
+impl fmt::Display for Format {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let layout = ["R", "RA", "RGB", "RGBA"][(self.channels.clamp(1, 4) - 1) as usize];
+        write!(f, "{layout} {} {}", self.channel_type, self.color_space)?;
+        if self.has_alpha() {
+            write!(f, " {} alpha", self.alpha)?;
+        }
+        Ok(())
+    }
+}
+
+/// Owned channel values of one image, in one of the storage types.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Texels {
+    /// 8-bit normalised values.
+    U8(Vec<u8>),
+    /// 16-bit normalised values.
+    U16(Vec<u16>),
+    /// Half floats.
+    F16(Vec<f16>),
+    /// Single floats.
+    F32(Vec<f32>),
+}
+
+impl Texels {
+    /// Number of channel values.
+    pub fn len(&self) -> usize {
+        match self {
+            Texels::U8(v) => v.len(),
+            Texels::U16(v) => v.len(),
+            Texels::F16(v) => v.len(),
+            Texels::F32(v) => v.len(),
+        }
+    }
+
+    /// True when there are no values.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The storage type.
+    pub fn channel_type(&self) -> ChannelType {
+        match self {
+            Texels::U8(_) => ChannelType::U8,
+            Texels::U16(_) => ChannelType::U16,
+            Texels::F16(_) => ChannelType::F16,
+            Texels::F32(_) => ChannelType::F32,
+        }
+    }
+
+    /// `len` zero values of the given type.
+    pub fn zeroed(ty: ChannelType, len: usize) -> Self {
+        match ty {
+            ChannelType::U8 => Texels::U8(vec![0; len]),
+            ChannelType::U16 => Texels::U16(vec![0; len]),
+            ChannelType::F16 => Texels::F16(vec![f16::ZERO; len]),
+            ChannelType::F32 => Texels::F32(vec![0.0; len]),
+        }
+    }
+}
+
+/// Decode stored values to linear-light f32 (`channels` values per texel).
+///
+/// `out` must have the same length as the stored values. Runs in parallel
+/// (rayon) on large inputs.
+pub fn decode_to_linear(format: &Format, texels: &Texels, out: &mut [f32]) {
+    let chunk = format.channels as usize * 16384;
+    match texels {
+        Texels::U8(v) => par_zip(v, out, chunk, |i, o| decode_u8(format, i, o)),
+        Texels::U16(v) => par_zip(v, out, chunk, |i, o| decode_u16(format, i, o)),
+        Texels::F16(v) => par_zip(v, out, chunk, |i, o| {
+            i.convert_to_f32_slice(o);
+            decode_float_srgb(format, o);
+        }),
+        Texels::F32(v) => par_zip(v, out, chunk, |i, o| {
+            o.copy_from_slice(i);
+            decode_float_srgb(format, o);
+        }),
+    }
+}
+
+/// Encode linear-light f32 values to storage, rounding to nearest.
+///
+/// Normalised types clamp to [0, 1] (NaN becomes 0). Float types keep the
+/// value, except that finite values beyond the f16 range saturate to
+/// ±65504 rather than becoming infinite (filter overshoot near the top of
+/// the range must not create infinities). Runs in parallel on large inputs.
+pub fn encode_from_linear(format: &Format, linear: &[f32], out: &mut Texels) {
+    let chunk = format.channels as usize * 16384;
+    match out {
+        Texels::U8(o) => par_zip(linear, o, chunk, |i, o| encode_u8(format, i, o)),
+        Texels::U16(o) => par_zip(linear, o, chunk, |i, o| encode_u16(format, i, o)),
+        Texels::F16(o) => par_zip(linear, o, chunk, |i, o| {
+            let mut tmp = i.to_vec();
+            encode_float_srgb(format, &mut tmp);
+            for v in &mut tmp {
+                if v.is_finite() {
+                    *v = v.clamp(-65504.0, 65504.0);
+                }
+            }
+            o.convert_from_f32_slice(&tmp);
+        }),
+        Texels::F32(o) => par_zip(linear, o, chunk, |i, o| {
+            o.copy_from_slice(i);
+            encode_float_srgb(format, o);
+        }),
+    }
+}
+
+fn par_zip<A: Sync, B: Send>(
+    a: &[A],
+    b: &mut [B],
+    chunk: usize,
+    f: impl Fn(&[A], &mut [B]) + Sync,
+) {
+    use rayon::prelude::*;
+    assert_eq!(a.len(), b.len(), "decode/encode length mismatch");
+    if a.len() <= chunk {
+        f(a, b);
+    } else {
+        a.par_chunks(chunk)
+            .zip(b.par_chunks_mut(chunk))
+            .for_each(|(a, b)| f(a, b));
+    }
+}
+
+/// Decode 8-bit values (whole texels) to linear f32.
+pub fn decode_u8(format: &Format, i: &[u8], o: &mut [f32]) {
+    let ch = format.channels as usize;
+    let t = srgb::tables();
+    for (o, i) in o.chunks_exact_mut(ch).zip(i.chunks_exact(ch)) {
+        for c in 0..ch {
+            o[c] = if format.is_srgb_channel(c) {
+                t.decode8[i[c] as usize]
+            } else {
+                i[c] as f32 * (1.0 / 255.0)
+            };
+        }
+    }
+}
+
+/// Decode 16-bit values (whole texels) to linear f32.
+pub fn decode_u16(format: &Format, i: &[u16], o: &mut [f32]) {
+    let ch = format.channels as usize;
+    let table = (format.color_space == ColorSpace::Srgb).then(srgb::decode16);
+    for (o, i) in o.chunks_exact_mut(ch).zip(i.chunks_exact(ch)) {
+        for c in 0..ch {
+            o[c] = match table {
+                Some(t) if format.is_srgb_channel(c) => t[i[c] as usize],
+                _ => i[c] as f32 * (1.0 / 65535.0),
+            };
+        }
+    }
+}
+
+/// Encode linear f32 (whole texels) to 8-bit values.
+pub fn encode_u8(format: &Format, i: &[f32], o: &mut [u8]) {
+    let ch = format.channels as usize;
+    let t = srgb::tables();
+    for (o, i) in o.chunks_exact_mut(ch).zip(i.chunks_exact(ch)) {
+        for c in 0..ch {
+            o[c] = if format.is_srgb_channel(c) {
+                srgb::encode_u8_with(t, i[c])
+            } else {
+                unorm8(i[c])
+            };
+        }
+    }
+}
+
+/// Encode linear f32 (whole texels) to 16-bit values.
+pub fn encode_u16(format: &Format, i: &[f32], o: &mut [u16]) {
+    let ch = format.channels as usize;
+    for (o, i) in o.chunks_exact_mut(ch).zip(i.chunks_exact(ch)) {
+        for c in 0..ch {
+            let v = if format.is_srgb_channel(c) {
+                srgb::encode_f64(i[c].clamp(0.0, 1.0) as f64) as f32
+            } else {
+                i[c]
+            };
+            o[c] = unorm16(v);
+        }
+    }
+}
+
+fn decode_float_srgb(format: &Format, out: &mut [f32]) {
+    if format.color_space != ColorSpace::Srgb {
+        return;
+    }
+    let ch = format.channels as usize;
+    let cc = format.color_channels();
+    for t in out.chunks_exact_mut(ch) {
+        for v in &mut t[..cc] {
+            // Odd extension for negative values, as scRGB-style data needs.
+            *v = v.signum() * srgb::decode(v.abs());
+        }
+    }
+}
+
+fn encode_float_srgb(format: &Format, v: &mut [f32]) {
+    if format.color_space != ColorSpace::Srgb {
+        return;
+    }
+    let ch = format.channels as usize;
+    let cc = format.color_channels();
+    for t in v.chunks_exact_mut(ch) {
+        for x in &mut t[..cc] {
+            *x = x.signum() * srgb::encode(x.abs());
+        }
+    }
+}
+
+/// Linear [0, 1] to an 8-bit code, round to nearest, NaN to 0.
+#[inline]
+pub fn unorm8(v: f32) -> u8 {
+    // `as` saturates and maps NaN to 0.
+    (v * 255.0 + 0.5) as u8
+}
+
+/// Linear [0, 1] to a 16-bit code, round to nearest, NaN to 0.
+#[inline]
+pub fn unorm16(v: f32) -> u16 {
+    (v * 65535.0 + 0.5) as u16
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unorm_round_trip_is_exact() {
+        let f = Format::new(1, ChannelType::U8, ColorSpace::Linear);
+        let src = Texels::U8((0..=255).collect());
+        let mut lin = vec![0.0; 256];
+        decode_to_linear(&f, &src, &mut lin);
+        let mut back = Texels::zeroed(ChannelType::U8, 256);
+        encode_from_linear(&f, &lin, &mut back);
+        assert_eq!(back, src);
+        let f = Format::new(1, ChannelType::U16, ColorSpace::Srgb);
+        let src = Texels::U16((0..=65535).collect());
+        let mut lin = vec![0.0; 65536];
+        decode_to_linear(&f, &src, &mut lin);
+        let mut back = Texels::zeroed(ChannelType::U16, 65536);
+        encode_from_linear(&f, &lin, &mut back);
+        assert_eq!(back, src);
+    }
+}
