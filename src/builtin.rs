@@ -90,7 +90,7 @@ pub fn generate(kind: Builtin, size: u32) -> Result<Texture> {
             let mut v = vec![0u8; n * n * 4];
             for (y, row) in v.chunks_exact_mut(n * 4).enumerate() {
                 for (x, t) in row.chunks_exact_mut(4).enumerate() {
-                    let on = ((x / cell) + (y / cell)) % 2 == 0;
+                    let on = ((x / cell) + (y / cell)).is_multiple_of(2);
                     t.copy_from_slice(if on {
                         &[255, 255, 255, 255]
                     } else {

@@ -396,10 +396,10 @@ fn validate(base: &Texture, options: &MipOptions) -> Result<()> {
 /// Reduce one level to `w × h` with the chosen filter (fast path if one
 /// applies, otherwise the separable path).
 pub fn reduce(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result<Texture> {
-    if options.fast_paths {
-        if let Some(t) = fast::try_reduce(src, w, h, options)? {
-            return Ok(t);
-        }
+    if options.fast_paths
+        && let Some(t) = fast::try_reduce(src, w, h, options)?
+    {
+        return Ok(t);
     }
     separable::reduce(src, w, h, options)
 }

@@ -45,21 +45,25 @@ impl AxisWeights {
 
 /// The exact (f64) weights of every destination texel.
 pub fn exact(filter: MipFilter, src: u32, dst: u32, wrap: WrapMode) -> Vec<Vec<(u32, f64)>> {
-    let s = src as f64 / dst as f64;
     (0..dst)
         .map(|x| {
             let mut taps: Vec<(i64, f64)> = Vec::new();
             if src == dst {
                 taps.push((x as i64, 1.0));
             } else if filter == MipFilter::Box {
-                let (lo, hi) = (x as f64 * s, (x as f64 + 1.0) * s);
-                for i in lo.floor() as i64..hi.ceil() as i64 {
-                    let w = (hi.min(i as f64 + 1.0) - lo.max(i as f64)).max(0.0);
-                    if w > 0.0 {
-                        taps.push((i, w));
+                // Exact integer overlap: scale both intervals by `dst` so
+                // source texel i is [i·dst, (i+1)·dst) and destination x is
+                // [x·src, (x+1)·src); no rounding can add or drop a tap.
+                let (src64, dst64) = (src as u64, dst as u64);
+                let (lo, hi) = (x as u64 * src64, (x as u64 + 1) * src64);
+                for i in lo / dst64..hi.div_ceil(dst64) {
+                    let o = hi.min((i + 1) * dst64).saturating_sub(lo.max(i * dst64));
+                    if o > 0 {
+                        taps.push((i as i64, o as f64 / src as f64));
                     }
                 }
             } else {
+                let s = src as f64 / dst as f64;
                 let k = filter.kernel();
                 let c = (x as f64 + 0.5) * s;
                 let r = k.radius() * s;

@@ -420,8 +420,9 @@ fn decode_float_srgb(format: &Format, out: &mut [f32]) {
     let cc = format.color_channels();
     for t in out.chunks_exact_mut(ch) {
         for v in &mut t[..cc] {
-            // Odd extension for negative values, as scRGB-style data needs.
-            *v = v.signum() * srgb::decode(v.abs());
+            // Odd extension for negative values, as scRGB-style data needs;
+            // f64 so that decode then encode gives the value back.
+            *v = (v.signum() as f64 * srgb::decode_f64(v.abs() as f64)) as f32;
         }
     }
 }
@@ -434,7 +435,7 @@ fn encode_float_srgb(format: &Format, v: &mut [f32]) {
     let cc = format.color_channels();
     for t in v.chunks_exact_mut(ch) {
         for x in &mut t[..cc] {
-            *x = x.signum() * srgb::encode(x.abs());
+            *x = (x.signum() as f64 * srgb::encode_f64(x.abs() as f64)) as f32;
         }
     }
 }

@@ -104,8 +104,7 @@ pub fn encode_u8(l: f32) -> u8 {
 
 #[inline]
 pub(crate) fn encode_u8_with(t: &Tables, l: f32) -> u8 {
-    // `!(l > 0.0)` also catches NaN.
-    if !(l > 0.0) {
+    if l.is_nan() || l <= 0.0 {
         return 0;
     }
     if l >= 1.0 {

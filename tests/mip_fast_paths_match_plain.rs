@@ -1,0 +1,79 @@
+//! The fast box paths agree with the plain separable path (and so with the
+//! brute-force reference): u8 linear and sRGB in every channel layout and
+//! alpha mode, and linear f32.
+
+mod common;
+use common::*;
+use parvo::mip::{self, MipOptions};
+use parvo::{AlphaMode, ChannelType, ColorSpace, Format};
+
+#[test]
+fn fast_box_paths_match_the_plain_path_and_the_reference() {
+    let mut rng = Rng(0xfa57);
+    for ty in [ChannelType::U8, ChannelType::F32] {
+        for ch in 1..=4u8 {
+            for cs in [ColorSpace::Linear, ColorSpace::Srgb] {
+                for alpha in [AlphaMode::Straight, AlphaMode::Premultiplied] {
+                    let f = Format::new(ch, ty, cs).with_alpha(alpha);
+                    for &(w, h) in &[(2u32, 2u32), (64, 32), (36, 200)] {
+                        let tex = random_texture(&mut rng, w, h, f);
+                        let fast = mip::build(tex.clone(), &MipOptions::default()).unwrap();
+                        let plain = mip::build(
+                            tex,
+                            &MipOptions {
+                                fast_paths: false,
+                                ..Default::default()
+                            },
+                        )
+                        .unwrap();
+                        assert_eq!(fast.len(), plain.len());
+                        for k in 1..fast.len() {
+                            let (a, b) = (&fast.levels()[k], &plain.levels()[k]);
+                            // Both within rounding of the exact value...
+                            let want = reference_reduce(
+                                &fast.levels()[k - 1],
+                                a.width() as usize,
+                                a.height() as usize,
+                                "box",
+                                "repeat",
+                                "repeat",
+                            );
+                            let tol = tolerance(ty);
+                            assert!(
+                                max_error(a, &want) <= tol,
+                                "fast {f} {w}x{h} level {k}: {}",
+                                max_error(a, &want)
+                            );
+                            let want = reference_reduce(
+                                &plain.levels()[k - 1],
+                                b.width() as usize,
+                                b.height() as usize,
+                                "box",
+                                "repeat",
+                                "repeat",
+                            );
+                            assert!(max_error(b, &want) <= tol, "plain {f} {w}x{h} level {k}");
+                            // ...and identical apart from exact ties.
+                            let diff = raw(a)
+                                .iter()
+                                .zip(raw(b))
+                                .filter(|(x, y)| {
+                                    (*x - y).abs()
+                                        > if ty == ChannelType::F32 {
+                                            y.abs() * 1e-6
+                                        } else {
+                                            0.0
+                                        }
+                                })
+                                .count();
+                            assert!(
+                                diff * 100 <= raw(a).len().max(100),
+                                "{f} {w}x{h} level {k}: {diff} differences"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
