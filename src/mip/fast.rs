@@ -75,16 +75,27 @@ pub fn box_u8(src: &[u8], sw: usize, fmt: Format, straight: Option<usize>, srgb:
                 let y = task * per + i;
                 let r0 = &src[2 * y * sw * ch..][..sw * ch];
                 let r1 = &src[(2 * y + 1) * sw * ch..][..sw * ch];
-                match tables {
-                    None => match ch {
-                        1 => row_u8_linear::<1>(r0, r1, tmp, d),
-                        2 => row_u8_linear::<2>(r0, r1, tmp, d),
-                        3 => row_u8_linear::<3>(r0, r1, tmp, d),
-                        _ => row_u8_linear::<4>(r0, r1, tmp, d),
-                    },
-                    Some(t) => row_u8_srgb(r0, r1, d, fmt, t),
-                }
-                if let Some(a) = straight {
+                let constant_alpha = match (tables, ch) {
+                    (None, 4) => simd::row_rgba8_dispatch(r0, r1, tmp, d),
+                    (None, _) => {
+                        match ch {
+                            1 => row_u8_linear::<1>(r0, r1, tmp, d),
+                            2 => row_u8_linear::<2>(r0, r1, tmp, d),
+                            _ => row_u8_linear::<3>(r0, r1, tmp, d),
+                        }
+                        false
+                    }
+                    (Some(t), _) => {
+                        row_u8_srgb(r0, r1, d, fmt, t);
+                        false
+                    }
+                };
+                if let Some(a) = straight
+                    && !constant_alpha
+                    && !(r0[a] == r1[a]
+                        && alpha_is_constant(r0, ch, a)
+                        && alpha_is_constant(r1, ch, a))
+                {
                     fix_straight_alpha_u8(r0, r1, d, ch, a, tables);
                 }
             }
@@ -102,6 +113,103 @@ fn row_u8_linear<const CH: usize>(r0: &[u8], r1: &[u8], tmp: &mut [u16], dst: &m
         for c in 0..CH {
             d[c] = ((s[c] + s[CH + c] + 2) >> 2) as u8;
         }
+    }
+}
+
+/// True when every texel of the row has the same alpha (the common opaque
+/// case). Alpha-carrying layouts have 2 or 4 channels, so 8-byte words hold
+/// whole texels: XOR each word with the first texel's alpha pattern, mask
+/// the alpha bytes and OR everything together (vectorises to a few
+/// instructions per 8 bytes).
+fn alpha_is_constant(row: &[u8], ch: usize, a: usize) -> bool {
+    debug_assert!(ch == 2 || ch == 4);
+    let (mut mask, mut pattern) = (0u64, 0u64);
+    for byte in (a..8).step_by(ch) {
+        mask |= 0xFF << (8 * byte);
+        pattern |= (row[a] as u64) << (8 * byte);
+    }
+    let words = row.chunks_exact(8);
+    let rest = words.remainder();
+    let acc = words.fold(0u64, |acc, w| {
+        acc | ((u64::from_le_bytes(w.try_into().expect("8 bytes")) ^ pattern) & mask)
+    });
+    acc == 0 && rest.chunks_exact(ch).all(|px| px[a] == row[a])
+}
+
+/// SIMD kernels. SSE2 is part of the x86-64 baseline; loads and stores go
+/// through arrays (`bytemuck::cast`), which compile to unaligned vector
+/// moves, so the kernel itself is safe code. Other targets use the plain
+/// loop.
+mod simd {
+    /// The RGBA8 row kernel for this target. Returns true when every alpha
+    /// byte of both rows equals `r0[3]` (then no alpha weighting is needed).
+    #[inline]
+    pub fn row_rgba8_dispatch(r0: &[u8], r1: &[u8], tmp: &mut [u16], dst: &mut [u8]) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
+        // SAFETY: `row_rgba8` only requires SSE2, which every x86_64 CPU has
+        // (it is in the target's baseline feature set).
+        unsafe {
+            row_rgba8(r0, r1, tmp, dst)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            super::row_u8_linear::<4>(r0, r1, tmp, dst);
+            r0[3] == r1[3]
+                && super::alpha_is_constant(r0, 4, 3)
+                && super::alpha_is_constant(r1, 4, 3)
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "sse2")]
+    fn row_rgba8(r0: &[u8], r1: &[u8], tmp: &mut [u16], dst: &mut [u8]) -> bool {
+        use std::arch::x86_64::*;
+        let load =
+            |s: &[u8]| -> __m128i { bytemuck::cast(<[u8; 16]>::try_from(s).expect("16 bytes")) };
+        let (zero, two) = (_mm_setzero_si128(), _mm_set1_epi16(2));
+        let alpha_mask = _mm_set1_epi32(0xFF00_0000u32 as i32);
+        let alpha_ref = _mm_set1_epi32(((r0[3] as u32) << 24) as i32);
+        let mut diff = zero;
+        let n = dst.len() / 16;
+        for ((d, a), b) in dst
+            .chunks_exact_mut(16)
+            .zip(r0.chunks_exact(32))
+            .zip(r1.chunks_exact(32))
+        {
+            let (a0, a1) = (load(&a[..16]), load(&a[16..]));
+            let (b0, b1) = (load(&b[..16]), load(&b[16..]));
+            let any = _mm_or_si128(_mm_xor_si128(a0, alpha_ref), _mm_xor_si128(a1, alpha_ref));
+            let any = _mm_or_si128(
+                any,
+                _mm_or_si128(_mm_xor_si128(b0, alpha_ref), _mm_xor_si128(b1, alpha_ref)),
+            );
+            diff = _mm_or_si128(diff, _mm_and_si128(any, alpha_mask));
+            // Vertical sums of pixels 0-1, 2-3, 4-5, 6-7 as u16 lanes.
+            let s0 = _mm_add_epi16(_mm_unpacklo_epi8(a0, zero), _mm_unpacklo_epi8(b0, zero));
+            let s1 = _mm_add_epi16(_mm_unpackhi_epi8(a0, zero), _mm_unpackhi_epi8(b0, zero));
+            let s2 = _mm_add_epi16(_mm_unpacklo_epi8(a1, zero), _mm_unpacklo_epi8(b1, zero));
+            let s3 = _mm_add_epi16(_mm_unpackhi_epi8(a1, zero), _mm_unpackhi_epi8(b1, zero));
+            // Horizontal pairs: low pixel + high pixel of each register.
+            let o01 = _mm_add_epi16(_mm_unpacklo_epi64(s0, s1), _mm_unpackhi_epi64(s0, s1));
+            let o23 = _mm_add_epi16(_mm_unpacklo_epi64(s2, s3), _mm_unpackhi_epi64(s2, s3));
+            let o01 = _mm_srli_epi16(_mm_add_epi16(o01, two), 2);
+            let o23 = _mm_srli_epi16(_mm_add_epi16(o23, two), 2);
+            let out: [u8; 16] = bytemuck::cast(_mm_packus_epi16(o01, o23));
+            d.copy_from_slice(&out);
+        }
+        let diff: [u64; 2] = bytemuck::cast(diff);
+        let mut constant = diff == [0, 0];
+        let done = n * 16;
+        if done < dst.len() {
+            let (t0, t1) = (&r0[2 * done..], &r1[2 * done..]);
+            super::row_u8_linear::<4>(t0, t1, &mut tmp[2 * done..], &mut dst[done..]);
+            constant &= t0
+                .chunks_exact(4)
+                .chain(t1.chunks_exact(4))
+                .all(|p| p[3] == r0[3]);
+        }
+        constant
     }
 }
 
@@ -142,32 +250,51 @@ fn fixed_tables() -> &'static FixedSrgb {
 
 impl FixedSrgb {
     /// Code of a sum of four decoded values (2^-26 units of linear light).
+    ///
+    /// Thresholds are at least ~20000 units apart (the steepest part of
+    /// the curve, near 0) and buckets 1024 wide, so the bucket's code is at
+    /// most one below the answer: one comparison, no loop.
     #[inline(always)]
     fn encode4(&self, s: u32) -> u8 {
-        let mut c = self.bucket[(s >> BUCKET_SHIFT) as usize] as usize;
-        while s >= self.thr[c] {
-            c += 1;
-        }
-        c as u8
+        let c = self.bucket[(s >> BUCKET_SHIFT) as usize];
+        c + u8::from(s >= self.thr[c as usize])
     }
 }
 
 fn row_u8_srgb(r0: &[u8], r1: &[u8], dst: &mut [u8], fmt: Format, t: &FixedSrgb) {
-    let ch = fmt.channels as usize;
-    let cc = fmt.color_channels();
-    let alpha = fmt.alpha_channel();
-    for (x, d) in dst.chunks_exact_mut(ch).enumerate() {
-        let (i0, i1) = (2 * x * ch, (2 * x + 1) * ch);
-        for c in 0..cc {
-            let s = t.dec[r0[i0 + c] as usize]
-                + t.dec[r0[i1 + c] as usize]
-                + t.dec[r1[i0 + c] as usize]
-                + t.dec[r1[i1 + c] as usize];
+    match fmt.channels {
+        1 => row_u8_srgb_n::<1, 1>(r0, r1, dst, t),
+        2 => row_u8_srgb_n::<2, 1>(r0, r1, dst, t),
+        3 => row_u8_srgb_n::<3, 3>(r0, r1, dst, t),
+        _ => row_u8_srgb_n::<4, 3>(r0, r1, dst, t),
+    }
+}
+
+/// `CH` channels of which the first `CC` are colour (the rest, if any, is
+/// a linear alpha channel).
+#[inline(always)]
+fn row_u8_srgb_n<const CH: usize, const CC: usize>(
+    r0: &[u8],
+    r1: &[u8],
+    dst: &mut [u8],
+    t: &FixedSrgb,
+) {
+    let dec = &t.dec;
+    for ((d, a), b) in dst
+        .chunks_exact_mut(CH)
+        .zip(r0.chunks_exact(2 * CH))
+        .zip(r1.chunks_exact(2 * CH))
+    {
+        for c in 0..CC {
+            let s = dec[a[c] as usize]
+                + dec[a[CH + c] as usize]
+                + dec[b[c] as usize]
+                + dec[b[CH + c] as usize];
             d[c] = t.encode4(s);
         }
-        if let Some(a) = alpha {
-            let s = r0[i0 + a] as u16 + r0[i1 + a] as u16 + r1[i0 + a] as u16 + r1[i1 + a] as u16;
-            d[a] = ((s + 2) >> 2) as u8;
+        for c in CC..CH {
+            let s = a[c] as u16 + a[CH + c] as u16 + b[c] as u16 + b[CH + c] as u16;
+            d[c] = ((s + 2) >> 2) as u8;
         }
     }
 }
@@ -277,6 +404,25 @@ fn row_f32_straight(r0: &[f32], r1: &[f32], dst: &mut [f32], ch: usize, a: usize
         }
         if 0.25 * sa <= 1e-7 {
             d[a] = d[a].max(0.0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_step_encode_equals_the_threshold_count_everywhere() {
+        let t = fixed_tables();
+        let count = |s: u32| t.thr.iter().filter(|&&x| s >= x).count() as u8;
+        let mut probes: Vec<u32> = (0..=(1u32 << 26)).step_by(4099).collect();
+        for &x in &t.thr[..255] {
+            probes.extend([x.saturating_sub(1), x, x + 1]);
+        }
+        probes.push(1 << 26);
+        for s in probes {
+            assert_eq!(t.encode4(s), count(s), "s = {s}");
         }
     }
 }

@@ -307,6 +307,57 @@ impl MipChain {
     }
 }
 
+/// Levels 1.. of `base`'s chain without taking or copying level 0 (for
+/// callers that keep the source elsewhere). NaN policies other than
+/// [`NanPolicy::Error`] need to modify level 0 and are refused here.
+pub fn build_reduced_levels(base: &Texture, options: &MipOptions) -> Result<Vec<Texture>> {
+    validate(base, options)?;
+    if options.nan_policy != NanPolicy::Error {
+        return Err(Error::InvalidOption(
+            "build_reduced_levels cannot repair level 0: use build with this NaN policy".into(),
+        ));
+    }
+    nan::check(base)?;
+    let sizes = level_sizes(
+        base.width(),
+        base.height(),
+        options.rounding,
+        options.max_levels,
+    );
+    let coverage0 = coverage_target(base, options);
+    let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len() - 1);
+    for &(w, h) in &sizes[1..] {
+        let prev = levels.last().unwrap_or(base);
+        let next = reduce_post(prev, w, h, options, coverage0)?;
+        levels.push(next);
+    }
+    Ok(levels)
+}
+
+fn coverage_target(base: &Texture, options: &MipOptions) -> Option<f32> {
+    match (options.alpha_coverage, base.format().alpha_channel()) {
+        (Some(r), Some(_)) => Some(alpha::coverage(base, r)),
+        _ => None,
+    }
+}
+
+fn reduce_post(
+    prev: &Texture,
+    w: u32,
+    h: u32,
+    options: &MipOptions,
+    coverage0: Option<f32>,
+) -> Result<Texture> {
+    let mut next = reduce(prev, w, h, options)?;
+    if let (Some(r), Some(c0)) = (options.alpha_coverage, coverage0) {
+        alpha::preserve_coverage(&mut next, r, c0);
+    }
+    if options.normal_map {
+        normal::renormalize(&mut next);
+    }
+    Ok(next)
+}
+
 /// Build the full chain of `base` (see the module docs).
 pub fn build(base: Texture, options: &MipOptions) -> Result<MipChain> {
     build_with_progress(base, options, &mut |_| {})
@@ -328,11 +379,7 @@ pub fn build_with_progress(
         options.max_levels,
     );
     let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
-    let coverage_ref = options.alpha_coverage;
-    let coverage0 = match (coverage_ref, base.format().alpha_channel()) {
-        (Some(r), Some(_)) => Some(alpha::coverage(&base, r)),
-        _ => None,
-    };
+    let coverage0 = coverage_target(&base, options);
     let mut p = Progress {
         levels_done: 1,
         levels_total: sizes.len() as u32,
@@ -344,13 +391,7 @@ pub fn build_with_progress(
     levels.push(base);
     for &(w, h) in &sizes[1..] {
         let prev = levels.last().expect("level 0 is present");
-        let mut next = reduce(prev, w, h, options)?;
-        if let (Some(r), Some(c0)) = (coverage_ref, coverage0) {
-            alpha::preserve_coverage(&mut next, r, c0);
-        }
-        if options.normal_map {
-            normal::renormalize(&mut next);
-        }
+        let next = reduce_post(prev, w, h, options, coverage0)?;
         levels.push(next);
         p.levels_done += 1;
         p.texels_done += w as u64 * h as u64;

@@ -53,6 +53,29 @@ impl FromStr for NanPolicy {
     }
 }
 
+/// [`NanPolicy::Error`] without modifying: the first non-finite value, as
+/// an error.
+pub fn check(tex: &Texture) -> Result<()> {
+    let (w, ch) = (tex.width() as usize, tex.channels());
+    let at = match tex.texels() {
+        Texels::F32(v) => v.iter().position(|x| !x.is_finite()).map(|i| (i, v[i])),
+        Texels::F16(v) => v
+            .iter()
+            .position(|x| !x.is_finite())
+            .map(|i| (i, v[i].to_f32())),
+        Texels::U8(_) | Texels::U16(_) => None,
+    };
+    match at {
+        None => Ok(()),
+        Some((i, value)) => Err(Error::NonFinite {
+            x: ((i / ch) % w) as u32,
+            y: ((i / ch) / w) as u32,
+            channel: (i % ch) as u8,
+            value,
+        }),
+    }
+}
+
 /// Apply `policy` to `tex` in place.
 pub fn apply(tex: &mut Texture, policy: NanPolicy) -> Result<()> {
     let (w, h, ch) = (tex.width() as usize, tex.height() as usize, tex.channels());
