@@ -35,9 +35,9 @@
 use crate::wrap::WrapMode;
 
 use super::MipMode;
-use super::bilinear::split;
+use super::bilinear::{fast_floor, split};
 use super::fetch::{Addressing, Level, lerp};
-use super::footprint::{clamp_lod, levels_for};
+use super::footprint::{clamp_lod, levels_for, log2};
 use super::trace::TexelSink;
 
 /// Largest semi-axis, in texels of the level being filtered, that EWA
@@ -82,7 +82,7 @@ pub(crate) fn ewa<S: TexelSink>(
         (1.0, 0.0)
     };
     let minor = minor0.max(major / max_aniso.clamp(1, 16) as f64);
-    let lambda = clamp_lod(minor.log2(), o);
+    let lambda = clamp_lod(log2(minor), o);
     let q = levels.len() - 1;
     let (hi, lo, delta) = if lambda > 0.0 {
         levels_for(lambda, q, mip)
@@ -156,8 +156,8 @@ fn ewa_level<S: TexelSink>(
     let (fs, ft) = (fs as f64, ft as f64);
     // Extent in t of the ellipse r² < 1 is sqrt(Σtt).
     let t_ext = ctt.sqrt();
-    let t0 = (ft - t_ext).ceil() as i64;
-    let t1 = (ft + t_ext).floor() as i64;
+    let t0 = -fast_floor(t_ext - ft);
+    let t1 = fast_floor(ft + t_ext);
     let e_alpha = (-ALPHA).exp();
     let mut acc = [0.0f64; 4];
     let mut wsum = 0.0f64;
@@ -170,8 +170,8 @@ fn ewa_level<S: TexelSink>(
             continue;
         }
         let half = disc.sqrt() / (2.0 * qa);
-        let s0 = (fs + centre - half).ceil() as i64;
-        let s1 = (fs + centre + half).floor() as i64;
+        let s0 = -fast_floor(half - fs - centre);
+        let s1 = fast_floor(fs + centre + half);
         for is in s0..=s1 {
             let ss = is as f64 - fs;
             let r2 = qa * ss * ss + qb * ss * tt + qc * tt * tt;

@@ -72,8 +72,10 @@ pub(crate) fn clamp_lod(base: f64, o: &SamplerOptions) -> f32 {
 pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Footprint {
     let (wf, hf) = (width as f64, height as f64);
     let (dx, dy) = derivatives(q, wf, hf);
-    let rho_x = (dx[0] * wf).hypot(dx[1] * hf);
-    let rho_y = (dy[0] * wf).hypot(dy[1] * hf);
+    // Plain sqrt, not `hypot` (a library call): the squares of finite f32
+    // derivatives times a u32 size stay far inside the f64 range.
+    let rho_x = length(dx[0] * wf, dx[1] * hf);
+    let rho_y = length(dy[0] * wf, dy[1] * hf);
     let (rho_max, rho_min, major) = if rho_x >= rho_y {
         (rho_x, rho_y, dx)
     } else {
@@ -87,15 +89,66 @@ pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Foot
     } else {
         (rho_max / rho_min).min(n)
     };
-    let lambda = clamp_lod((rho_max / eta).log2(), o);
+    let lambda = clamp_lod(log2(rho_max / eta), o);
     Footprint {
         rho_x,
         rho_y,
         eta,
         lambda,
-        probes: eta.ceil() as u32,
+        probes: ceil_small(eta),
         major,
     }
+}
+
+/// log2 for the LOD, inlined: exact at powers of two, error below 1e-10
+/// elsewhere (GPUs keep 4–8 fractional bits of λ). `f64::log2` is a
+/// library call, which also forces every live vector register to be
+/// spilled around it; inlined, the whole lookup stays in registers.
+#[inline(always)]
+pub(crate) fn log2(x: f64) -> f64 {
+    if !(x >= f64::MIN_POSITIVE && x <= f64::MAX) {
+        // 0 (→ −∞), subnormals, ∞, NaN: the library handles them.
+        return x.log2();
+    }
+    let bits = x.to_bits();
+    let mut e = ((bits >> 52) as i64) - 1023;
+    let mut m = f64::from_bits((bits & ((1u64 << 52) - 1)) | (1023u64 << 52));
+    if m > std::f64::consts::SQRT_2 {
+        m *= 0.5;
+        e += 1;
+    }
+    // ln m = 2·atanh(s), s = (m − 1)/(m + 1), |s| ≤ 0.1716.
+    let s = (m - 1.0) / (m + 1.0);
+    let s2 = s * s;
+    let p = s
+        * (2.0
+            + s2 * (2.0 / 3.0
+                + s2 * (2.0 / 5.0
+                    + s2 * (2.0 / 7.0 + s2 * (2.0 / 9.0 + s2 * (2.0 / 11.0))))));
+    e as f64 + p * std::f64::consts::LOG2_E
+}
+
+/// λ of an isotropic filter (`max_aniso == 1`): η = 1, so
+/// λ = clamp(½·log2(max(ρx², ρy²)) + bias) — no square roots.
+#[inline(always)]
+pub(crate) fn isotropic_lambda(q: &Query, wf: f64, hf: f64, o: &SamplerOptions) -> f32 {
+    let (dx, dy) = derivatives(q, wf, hf);
+    let (ax, ay) = (dx[0] * wf, dx[1] * hf);
+    let (bx, by) = (dy[0] * wf, dy[1] * hf);
+    let r2 = (ax * ax + ay * ay).max(bx * bx + by * by);
+    clamp_lod(0.5 * log2(r2), o)
+}
+
+/// ceil of η ∈ [1, 16] without the `f64::ceil` library call.
+#[inline(always)]
+fn ceil_small(eta: f64) -> u32 {
+    let t = eta as u32;
+    if t as f64 == eta { t } else { t + 1 }
+}
+
+#[inline(always)]
+fn length(a: f64, b: f64) -> f64 {
+    (a * a + b * b).sqrt()
 }
 
 /// Nearest mip level for λ > 0 in a chain of `q + 1` levels:
@@ -103,8 +156,11 @@ pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Foot
 /// picks level k).
 #[inline(always)]
 pub fn mip_nearest(lambda: f32, q: usize) -> usize {
-    let d = lambda.clamp(0.0, q as f32);
-    (((d + 0.5).ceil() - 1.0).max(0.0) as usize).min(q)
+    // d' ≥ 0, so truncation is floor and ceil(x) − 1 = trunc(x) − [x integral].
+    let x = lambda.clamp(0.0, q as f32) + 0.5;
+    let t = x as usize;
+    let d = if t as f32 == x { t - 1 } else { t };
+    d.min(q)
 }
 
 /// Linear mip levels for λ > 0: `(d_hi, d_lo, δ)` with d_hi = floor(d'),
@@ -113,9 +169,9 @@ pub fn mip_nearest(lambda: f32, q: usize) -> usize {
 #[inline(always)]
 pub fn mip_linear(lambda: f32, q: usize) -> (usize, usize, f32) {
     let d = lambda.clamp(0.0, q as f32);
-    let hi = d.floor();
-    let h = (hi as usize).min(q);
-    (h, (h + 1).min(q), d - hi)
+    // d ≥ 0: truncation is the floor (and `f32::floor` a library call).
+    let h = (d as usize).min(q);
+    (h, (h + 1).min(q), d - h as f32)
 }
 
 /// Which levels a lookup at λ reads with mip mode `mip` (λ > 0).

@@ -16,6 +16,8 @@
 //! - [`trace`]: every filter is generic over a [`TexelSink`] that sees each
 //!   texel read; [`NoTrace`] compiles away.
 //! - `batch`: slices of queries, serial or in parallel (rayon).
+//! - [`plane`]: perspective ground-plane queries, the scene the accuracy
+//!   tests, benchmarks and examples share.
 //!
 //! # Alpha
 //! Texels are filtered as stored, as GPU samplers do: a straight-alpha
@@ -59,6 +61,7 @@ mod bilinear;
 pub mod ewa;
 pub mod fetch;
 pub mod footprint;
+pub mod plane;
 mod query;
 mod supersample;
 pub mod trace;
@@ -475,6 +478,8 @@ impl fmt::Display for SamplerOptions {
 /// What [`Sampler`] runs (validated options, `Sat` excluded).
 #[derive(Clone, Copy, Debug)]
 enum Kernel {
+    /// `Texel` with `max_aniso == 1`: η = 1, one probe, λ without roots.
+    Isotropic,
     Texel,
     Ewa,
     Supersample,
@@ -508,6 +513,7 @@ impl Sampler {
     pub fn from_linear(chain: Arc<LinearChain>, options: SamplerOptions) -> Result<Self> {
         options.validate()?;
         let kernel = match options.method {
+            Method::Texel if options.max_aniso == 1 => Kernel::Isotropic,
             Method::Texel => Kernel::Texel,
             Method::Ewa => Kernel::Ewa,
             Method::Supersample => Kernel::Supersample,
@@ -559,6 +565,11 @@ impl Sampler {
         let u = coord(q.u);
         let v = coord(q.v);
         match self.kernel {
+            Kernel::Isotropic => {
+                let l = &levels[0];
+                let lambda = footprint::isotropic_lambda(q, l.wf, l.hf, &self.options);
+                trilinear::isotropic(levels, self.iso, &self.addr, u, v, lambda, sink)
+            }
             Kernel::Texel => {
                 let l = &levels[0];
                 let fp = footprint(q, l.w, l.h, &self.options);
