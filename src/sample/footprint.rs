@@ -52,10 +52,7 @@ pub(crate) fn derivatives(q: &Query, wf: f64, hf: f64) -> ([f64; 2], [f64; 2]) {
             [q.dudy as f64, q.dvdy as f64],
         )
     } else {
-        (
-            [UNBOUNDED_TEXELS / wf, 0.0],
-            [0.0, UNBOUNDED_TEXELS / hf],
-        )
+        ([UNBOUNDED_TEXELS / wf, 0.0], [0.0, UNBOUNDED_TEXELS / hf])
     }
 }
 
@@ -123,8 +120,7 @@ pub(crate) fn log2(x: f64) -> f64 {
     let p = s
         * (2.0
             + s2 * (2.0 / 3.0
-                + s2 * (2.0 / 5.0
-                    + s2 * (2.0 / 7.0 + s2 * (2.0 / 9.0 + s2 * (2.0 / 11.0))))));
+                + s2 * (2.0 / 5.0 + s2 * (2.0 / 7.0 + s2 * (2.0 / 9.0 + s2 * (2.0 / 11.0))))));
     e as f64 + p * std::f64::consts::LOG2_E
 }
 

@@ -401,10 +401,7 @@ impl SamplerOptions {
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(Error::InvalidOption(m));
         if !(1..=16).contains(&self.max_aniso) {
-            return bad(format!(
-                "max anisotropy {} must be 1 to 16",
-                self.max_aniso
-            ));
+            return bad(format!("max anisotropy {} must be 1 to 16", self.max_aniso));
         }
         for (name, x) in [
             ("LOD bias", self.lod_bias),
