@@ -12,7 +12,7 @@
 //! texels. A probe position is computed in `f64`; huge derivative vectors
 //! give huge (saturated, then wrapped) positions, never NaN.
 
-use super::fetch::{Addressing, Level, add_scaled, scale};
+use super::fetch::{Addressing, Level};
 use super::footprint::Footprint;
 use super::trace::TexelSink;
 use super::trilinear::{Iso, isotropic};
@@ -33,7 +33,8 @@ pub(crate) fn anisotropic<S: TexelSink>(
         return isotropic(levels, o, a, u, v, fp.lambda, sink);
     }
     let step = 1.0 / (n as f64 + 1.0);
-    let mut acc = [0.0f32; 4];
+    // f64 sum: 16 probes of texels near f32::MAX must not overflow.
+    let mut acc = [0.0f64; 4];
     for i in 1..=n {
         let t = i as f64 * step - 0.5;
         let p = isotropic(
@@ -45,7 +46,10 @@ pub(crate) fn anisotropic<S: TexelSink>(
             fp.lambda,
             sink,
         );
-        add_scaled(&mut acc, p, 1.0);
+        for c in 0..4 {
+            acc[c] += p[c] as f64;
+        }
     }
-    scale(acc, 1.0 / n as f32)
+    let inv = 1.0 / n as f64;
+    acc.map(|x| (x * inv) as f32)
 }

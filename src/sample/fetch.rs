@@ -164,17 +164,3 @@ pub(crate) fn mix(x: [f32; 4], a: f32, y: [f32; 4], b: f32) -> [f32; 4] {
 pub(crate) fn lerp(x: [f32; 4], y: [f32; 4], t: f32) -> [f32; 4] {
     mix(x, 1.0 - t, y, t)
 }
-
-/// `acc + w·x` per channel.
-#[inline(always)]
-pub(crate) fn add_scaled(acc: &mut [f32; 4], x: [f32; 4], w: f32) {
-    for c in 0..4 {
-        acc[c] += x[c] * w;
-    }
-}
-
-/// `x · s` per channel.
-#[inline(always)]
-pub(crate) fn scale(x: [f32; 4], s: f32) -> [f32; 4] {
-    [x[0] * s, x[1] * s, x[2] * s, x[3] * s]
-}
