@@ -587,3 +587,78 @@ fn option_names_round_trip_and_bad_options_are_errors() {
     .collect();
     assert_eq!(set.len(), 2);
 }
+
+#[test]
+fn ewa_matches_a_brute_force_scan_of_the_spec_formula() {
+    // Level 0 only, anisotropy below the clamp: the ellipse is exactly
+    // SPEC's A, B, C from the raw derivative vectors.
+    let (w, h) = (32u32, 24u32);
+    let t = random_texture(w, h, 17);
+    let o = SamplerOptions {
+        mip: MipMode::None,
+        ..SamplerOptions::ewa()
+    };
+    let s = sampler(&single(t.clone()), o);
+    let mut r = Rng(23);
+    let mut checked = 0;
+    while checked < 300 {
+        let (s0, t0) = ((r.f() - 0.5) * 12.0, (r.f() - 0.5) * 12.0);
+        let (s1, t1) = ((r.f() - 0.5) * 12.0, (r.f() - 0.5) * 12.0);
+        // Singular values of [[s0, s1], [t0, t1]]: skip clamped ratios.
+        let (a, b, c) = (s0 * s0 + s1 * s1, s0 * t0 + s1 * t1, t0 * t0 + t1 * t1);
+        let root = (((a - c) * 0.5).powi(2) + b * b).sqrt();
+        let (big, small) = ((a + c) * 0.5 + root, (a + c) * 0.5 - root);
+        if small <= 0.0 || (big / small).sqrt() > 15.0 {
+            continue;
+        }
+        checked += 1;
+        let (u, v) = (r.f() * 2.0 - 0.5, r.f() * 2.0 - 0.5);
+        let q = Query::new(
+            u,
+            v,
+            s0 / w as f32,
+            t0 / h as f32,
+            s1 / w as f32,
+            t1 / h as f32,
+        );
+        // The query's f32 derivatives, back in texels, in f64.
+        let ds0 = q.dudx as f64 * w as f64;
+        let dt0 = q.dvdx as f64 * h as f64;
+        let ds1 = q.dudy as f64 * w as f64;
+        let dt1 = q.dvdy as f64 * h as f64;
+        let mut qa = dt0 * dt0 + dt1 * dt1 + 1.0;
+        let mut qb = -2.0 * (ds0 * dt0 + ds1 * dt1);
+        let mut qc = ds0 * ds0 + ds1 * ds1 + 1.0;
+        let f = qa * qc - qb * qb / 4.0;
+        qa /= f;
+        qb /= f;
+        qc /= f;
+        let (sc, tc) = (u as f64 * w as f64 - 0.5, v as f64 * h as f64 - 0.5);
+        let mut sum = [0f64; 4];
+        let mut wsum = 0.0;
+        for j in (tc as i64 - 30)..(tc as i64 + 30) {
+            for i in (sc as i64 - 30)..(sc as i64 + 30) {
+                let (ss, tt) = (i as f64 - sc, j as f64 - tc);
+                let r2 = qa * ss * ss + qb * ss * tt + qc * tt * tt;
+                if r2 < 1.0 {
+                    let wt = (-2.0 * r2).exp() - (-2.0f64).exp();
+                    let tx = texel(
+                        &t,
+                        i.rem_euclid(w as i64) as u32,
+                        j.rem_euclid(h as i64) as u32,
+                    );
+                    for ch in 0..4 {
+                        sum[ch] += wt * tx[ch] as f64;
+                    }
+                    wsum += wt;
+                }
+            }
+        }
+        let want = sum.map(|x| (x / wsum) as f32);
+        assert!(
+            close(s.sample(&q), want, 2e-5),
+            "{q:?}: {:?} vs {want:?}",
+            s.sample(&q)
+        );
+    }
+}

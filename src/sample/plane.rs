@@ -105,3 +105,23 @@ impl GroundPlane {
         self.pixels().into_iter().map(|(_, q)| q).collect()
     }
 }
+
+/// Root-mean-square difference over the colour channels (R, G, B) of two
+/// equally long lists of results; the accuracy score of a filter against
+/// the supersampled reference.
+pub fn rmse(reference: &[[f32; 4]], got: &[[f32; 4]]) -> f64 {
+    let n = reference.len().min(got.len());
+    if n == 0 {
+        return 0.0;
+    }
+    let sum: f64 = reference
+        .iter()
+        .zip(got)
+        .map(|(a, b)| {
+            (0..3)
+                .map(|c| (a[c] as f64 - b[c] as f64).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
+    (sum / (3 * n) as f64).sqrt()
+}
