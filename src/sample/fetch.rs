@@ -127,6 +127,9 @@ impl Level {
         a: &Addressing,
         sink: &mut S,
     ) -> [f32; 4] {
+        if (0..self.w as i64).contains(&i) && (0..self.h as i64).contains(&j) {
+            return self.at(li, i as usize, j as usize, sink);
+        }
         match (
             wrap_index(a.wrap.u, i, self.w),
             wrap_index(a.wrap.v, j, self.h),

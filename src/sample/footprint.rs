@@ -69,14 +69,16 @@ pub(crate) fn clamp_lod(base: f64, o: &SamplerOptions) -> f32 {
 pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Footprint {
     let (wf, hf) = (width as f64, height as f64);
     let (dx, dy) = derivatives(q, wf, hf);
-    // Plain sqrt, not `hypot` (a library call): the squares of finite f32
-    // derivatives times a u32 size stay far inside the f64 range.
-    let rho_x = length(dx[0] * wf, dx[1] * hf);
-    let rho_y = length(dy[0] * wf, dy[1] * hf);
-    let (rho_max, rho_min, major) = if rho_x >= rho_y {
-        (rho_x, rho_y, dx)
+    // Squared lengths first (plain products, not the `hypot` library
+    // call: the squares of finite f32 derivatives times a u32 size stay far
+    // inside the f64 range).
+    let rx2 = square_len(dx[0] * wf, dx[1] * hf);
+    let ry2 = square_len(dy[0] * wf, dy[1] * hf);
+    let (rho_x, rho_y) = (rx2.sqrt(), ry2.sqrt());
+    let (max2, rho_max, rho_min, major) = if rx2 >= ry2 {
+        (rx2, rho_x, rho_y, dx)
     } else {
-        (rho_y, rho_x, dy)
+        (ry2, rho_y, rho_x, dy)
     };
     let n = o.max_aniso.clamp(1, 16) as f64;
     let eta = if rho_max == 0.0 {
@@ -86,7 +88,9 @@ pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Foot
     } else {
         (rho_max / rho_min).min(n)
     };
-    let lambda = clamp_lod(log2(rho_max / eta), o);
+    // log2(ρmax/η) as ½·log2(ρmax²/η²): for η = 1 this is bit for bit the
+    // isotropic path's λ, so aniso with η = 1 equals trilinear exactly.
+    let lambda = clamp_lod(0.5 * log2(max2 / (eta * eta)), o);
     Footprint {
         rho_x,
         rho_y,
@@ -97,10 +101,14 @@ pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Foot
     }
 }
 
-/// log2 for the LOD, inlined: exact at powers of two, error below 1e-10
-/// elsewhere (GPUs keep 4–8 fractional bits of λ). `f64::log2` is a
-/// library call, which also forces every live vector register to be
-/// spilled around it; inlined, the whole lookup stays in registers.
+/// log2 for the LOD, inlined: exact at powers of two, error below 2e-7
+/// elsewhere (GPUs keep 4–8 fractional bits of λ).
+///
+/// `f64::log2` is a library call (which also spills every live vector
+/// register around it) and a polynomial is a long dependent chain; both
+/// cost more than the rest of a bilinear lookup. Here: the exponent, plus
+/// a linear interpolation in a 1024-entry table of log2 over the mantissa
+/// (4 KiB, computed at compile time).
 #[inline(always)]
 pub(crate) fn log2(x: f64) -> f64 {
     if !(x >= f64::MIN_POSITIVE && x <= f64::MAX) {
@@ -108,20 +116,48 @@ pub(crate) fn log2(x: f64) -> f64 {
         return x.log2();
     }
     let bits = x.to_bits();
-    let mut e = ((bits >> 52) as i64) - 1023;
-    let mut m = f64::from_bits((bits & ((1u64 << 52) - 1)) | (1023u64 << 52));
-    if m > std::f64::consts::SQRT_2 {
-        m *= 0.5;
-        e += 1;
+    let e = ((bits >> 52) as i64 - 1023) as f64;
+    let mant = bits & ((1u64 << 52) - 1);
+    let i = (mant >> (52 - LOG2_BITS)) as usize;
+    let f = (mant & ((1u64 << (52 - LOG2_BITS)) - 1)) as f64
+        * (1.0 / (1u64 << (52 - LOG2_BITS)) as f64);
+    let a = LOG2_TABLE[i] as f64;
+    let b = LOG2_TABLE[i + 1] as f64;
+    e + (a + f * (b - a))
+}
+
+const LOG2_BITS: u32 = 10;
+
+/// log2(1 + i/1024), i = 0..=1024.
+static LOG2_TABLE: [f32; (1 << LOG2_BITS) + 1] = {
+    let mut t = [0f32; (1 << LOG2_BITS) + 1];
+    let mut i = 0;
+    while i < t.len() {
+        t[i] = log2_series(1.0 + i as f64 / (1u64 << LOG2_BITS) as f64) as f32;
+        i += 1;
     }
+    t
+};
+
+/// log2(m) for m in [1, 2] by the atanh series (compile time only).
+const fn log2_series(m: f64) -> f64 {
+    let (m, e) = if m > std::f64::consts::SQRT_2 {
+        (m * 0.5, 1.0)
+    } else {
+        (m, 0.0)
+    };
     // ln m = 2·atanh(s), s = (m − 1)/(m + 1), |s| ≤ 0.1716.
     let s = (m - 1.0) / (m + 1.0);
     let s2 = s * s;
-    let p = s
-        * (2.0
-            + s2 * (2.0 / 3.0
-                + s2 * (2.0 / 5.0 + s2 * (2.0 / 7.0 + s2 * (2.0 / 9.0 + s2 * (2.0 / 11.0))))));
-    e as f64 + p * std::f64::consts::LOG2_E
+    let mut sum = 0.0;
+    let mut term = s;
+    let mut k = 1.0;
+    while k < 40.0 {
+        sum += term / k;
+        term *= s2;
+        k += 2.0;
+    }
+    e + 2.0 * sum * std::f64::consts::LOG2_E
 }
 
 /// λ of an isotropic filter (`max_aniso == 1`): η = 1, so
@@ -131,7 +167,7 @@ pub(crate) fn isotropic_lambda(q: &Query, wf: f64, hf: f64, o: &SamplerOptions) 
     let (dx, dy) = derivatives(q, wf, hf);
     let (ax, ay) = (dx[0] * wf, dx[1] * hf);
     let (bx, by) = (dy[0] * wf, dy[1] * hf);
-    let r2 = (ax * ax + ay * ay).max(bx * bx + by * by);
+    let r2 = square_len(ax, ay).max(square_len(bx, by));
     clamp_lod(0.5 * log2(r2), o)
 }
 
@@ -143,8 +179,8 @@ fn ceil_small(eta: f64) -> u32 {
 }
 
 #[inline(always)]
-fn length(a: f64, b: f64) -> f64 {
-    (a * a + b * b).sqrt()
+fn square_len(a: f64, b: f64) -> f64 {
+    a * a + b * b
 }
 
 /// Nearest mip level for λ > 0 in a chain of `q + 1` levels:
@@ -153,10 +189,11 @@ fn length(a: f64, b: f64) -> f64 {
 #[inline(always)]
 pub fn mip_nearest(lambda: f32, q: usize) -> usize {
     // d' ≥ 0, so truncation is floor and ceil(x) − 1 = trunc(x) − [x integral].
+    // (i32 conversions are one instruction; usize ones are not.)
     let x = lambda.clamp(0.0, q as f32) + 0.5;
-    let t = x as usize;
-    let d = if t as f32 == x { t - 1 } else { t };
-    d.min(q)
+    let t = x as i32;
+    let d = t - i32::from(t as f32 == x);
+    (d.max(0) as usize).min(q)
 }
 
 /// Linear mip levels for λ > 0: `(d_hi, d_lo, δ)` with d_hi = floor(d'),
@@ -166,7 +203,7 @@ pub fn mip_nearest(lambda: f32, q: usize) -> usize {
 pub fn mip_linear(lambda: f32, q: usize) -> (usize, usize, f32) {
     let d = lambda.clamp(0.0, q as f32);
     // d ≥ 0: truncation is the floor (and `f32::floor` a library call).
-    let h = (d as usize).min(q);
+    let h = (d as i32 as usize).min(q);
     (h, (h + 1).min(q), d - h as f32)
 }
 
