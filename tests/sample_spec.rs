@@ -342,15 +342,15 @@ fn repeat_keeps_subtexel_precision_at_u_one_million() {
     let s = sampler(&single(t.clone()), SamplerOptions::bilinear());
     // u = 1e6 + 0.125 is exact in f32; x = 4e6 + 0.5 is the centre of
     // texel 4e6 ≡ 0 (mod 4).
-    let got = s.sample(&Query::point(1_000_000.125, 0.125));
+    let got = s.sample(&Query::point(1e6 + 0.125, 0.125));
     assert_eq!(got, texel(&t, 0, 0));
     // u = 1e6 + 0.25: x − 0.5 = 4e6 + 0.5, halfway between texels 0 and 1.
-    let got = s.sample(&Query::point(1_000_000.25, 0.125));
+    let got = s.sample(&Query::point(1e6 + 0.25, 0.125));
     let (a, b) = (texel(&t, 0, 0), texel(&t, 1, 0));
     assert!(close(got, [0, 1, 2, 3].map(|c| 0.5 * (a[c] + b[c])), 1e-6));
     // Negative: u = −1e6 + 0.625 → x = −4e6 + 2.5 → texel 2.
     assert_eq!(
-        s.sample(&Query::point(-999_999.375, 0.125)),
+        s.sample(&Query::point(-1e6 + 0.625, 0.125)),
         texel(&t, 2, 0)
     );
 }

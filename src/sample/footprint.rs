@@ -111,7 +111,7 @@ pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Foot
 /// (4 KiB, computed at compile time).
 #[inline(always)]
 pub(crate) fn log2(x: f64) -> f64 {
-    if !(x >= f64::MIN_POSITIVE && x <= f64::MAX) {
+    if !(f64::MIN_POSITIVE..=f64::MAX).contains(&x) {
         // 0 (→ −∞), subnormals, ∞, NaN: the library handles them.
         return x.log2();
     }
@@ -198,7 +198,7 @@ pub fn mip_nearest(lambda: f32, q: usize) -> usize {
 
 /// Linear mip levels for λ > 0: `(d_hi, d_lo, δ)` with d_hi = floor(d'),
 /// d_lo = min(d_hi + 1, q), δ = d' − d_hi; the result is
-/// (1 − δ)·τ[d_hi] + δ·τ[d_lo].
+/// (1 − δ)·τ\[d_hi\] + δ·τ\[d_lo\].
 #[inline(always)]
 pub fn mip_linear(lambda: f32, q: usize) -> (usize, usize, f32) {
     let d = lambda.clamp(0.0, q as f32);

@@ -5,7 +5,7 @@
 //! - [`SamplerOptions`] (a hashable value type with presets) and
 //!   [`Sampler`], built once from a [`MipChain`] (decoded to linear RGBA
 //!   `f32` by [`LinearChain`]; see [`fetch`] for the memory cost).
-//! - [`footprint`]: ρ, η, λ and the mip-level rules, exactly as SPEC.md
+//! - [`footprint`](mod@footprint): ρ, η, λ and the mip-level rules, exactly as SPEC.md
 //!   (after Vulkan and EXT_texture_filter_anisotropic) states them.
 //! - One file per filter: nearest and bilinear within a level
 //!   (`bilinear`), magnification/minification/mip modes and trilinear
