@@ -35,7 +35,8 @@
 //!   its unit reconstruction Gaussian on level 0.
 //! - NaN or infinite derivatives: an unbounded isotropic footprint (see
 //!   [`footprint::UNBOUNDED_TEXELS`]): the coarsest level allowed, one
-//!   probe.
+//!   probe (the supersampled reference, always on level 0, spreads its
+//!   lookups over that footprint).
 //! - Huge finite derivatives select the coarsest level; the work per query
 //!   is bounded for every filter: at most 16 probes × 8 texels for
 //!   footprint assembly, `supersample²` bilinear lookups for the reference,
