@@ -7,6 +7,10 @@
 //!                      │ mip::build(MipOptions)
 //!                      ▼
 //!                   MipChain (levels in the source format)
+//!                      │ sample::Sampler::new(SamplerOptions): decode to linear RGBA f32
+//!                      ▼
+//! Query{uv, derivatives} ──▶ Footprint (λ, η) ──▶ filter ──▶ [f32; 4]
+//!                                                   └──▶ TexelSink (every texel read)
 //! ```
 //!
 //! - [`texel`]: formats (1–4 channels; u8, u16, f16, f32; linear or sRGB;
@@ -20,6 +24,9 @@
 //! - [`mip`]: level sizes, kernels, polyphase weights, the separable
 //!   reference path and the fast box paths, alpha coverage and normal
 //!   renormalisation, the chain builder.
+//! - [`sample`]: [`SamplerOptions`], [`Query`], the footprint (LOD,
+//!   anisotropy) and the filters from nearest to EWA, generic over a
+//!   [`TexelSink`] that sees every texel read; batch sampling on rayon.
 //!
 //! The library never prints and never panics on bad input: errors are
 //! [`Error`] values, long builds report through a progress callback.
@@ -38,12 +45,14 @@
 pub mod builtin;
 pub mod error;
 pub mod mip;
+pub mod sample;
 pub mod texel;
 pub mod texture;
 pub mod wrap;
 
 pub use error::{Error, Result};
 pub use mip::{MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
+pub use sample::{Filter, Query, Sampler, SamplerOptions, TexelSink};
 pub use texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 pub use texture::Texture;
 pub use wrap::{Wrap, WrapMode};

@@ -1,0 +1,620 @@
+//! Samplers: a texture coordinate and its screen-space derivatives in, a
+//! filtered linear-light RGBA colour out.
+//!
+//! # Structure
+//! - [`SamplerOptions`] (a hashable value type with presets) and
+//!   [`Sampler`], built once from a [`MipChain`] (decoded to linear RGBA
+//!   `f32` by [`LinearChain`]; see [`fetch`] for the memory cost).
+//! - [`footprint`](mod@footprint): ρ, η, λ and the mip-level rules, exactly as SPEC.md
+//!   (after Vulkan and EXT_texture_filter_anisotropic) states them.
+//! - One file per filter: nearest and bilinear within a level
+//!   (`bilinear`), magnification/minification/mip modes and trilinear
+//!   (`trilinear`), footprint assembly (`aniso`), EWA ([`ewa`]), and the
+//!   supersampled reference (`supersample`). `nearest`, `bilinear`,
+//!   `trilinear` and `aniso` are one code path: footprint assembly with
+//!   `max_aniso = 1` is the isotropic filter.
+//! - [`trace`]: every filter is generic over a [`TexelSink`] that sees each
+//!   texel read; [`NoTrace`] compiles away.
+//! - `batch`: slices of queries, serial or in parallel (rayon).
+//! - [`plane`]: perspective ground-plane queries, the scene the accuracy
+//!   tests, benchmarks and examples share.
+//!
+//! # Alpha
+//! Texels are filtered as stored, as GPU samplers do: a straight-alpha
+//! texture's colour is not weighted by alpha here (the mip chain builder
+//! does that when it builds the levels). Every result is a convex
+//! combination of texels (and the border colour), up to `f32` rounding.
+//!
+//! # Extreme inputs (all tested)
+//! - NaN `u` or `v` reads as 0; ±Inf and huge coordinates saturate to
+//!   texel index ±2^62 and are then wrapped, with fraction 0.
+//! - Coordinates far outside [0, 1] are wrapped on integer texel indices
+//!   computed in `f64`, so `u = 1e6` under `repeat` keeps its sub-texel
+//!   position.
+//! - Zero derivatives: magnification (λ = −∞ before the clamp); EWA uses
+//!   its unit reconstruction Gaussian on level 0.
+//! - NaN or infinite derivatives: an unbounded isotropic footprint (see
+//!   [`footprint::UNBOUNDED_TEXELS`]): the coarsest level allowed, one
+//!   probe (the supersampled reference, always on level 0, spreads its
+//!   lookups over that footprint).
+//! - Huge finite derivatives select the coarsest level; the work per query
+//!   is bounded for every filter: at most 16 probes × 8 texels for
+//!   footprint assembly, `supersample²` bilinear lookups for the reference,
+//!   and an ellipse of at most [`ewa::MAX_RADIUS`] texels for EWA.
+//! - The output is never NaN when the texels and the border colour are
+//!   finite.
+//!
+//! ```
+//! use parvo::sample::{Query, Sampler, SamplerOptions};
+//! let chain = parvo::mip::build(
+//!     parvo::builtin::load("builtin:checker:64")?,
+//!     &parvo::MipOptions::default(),
+//! )?;
+//! let sampler = Sampler::new(&chain, SamplerOptions::aniso(8))?;
+//! let rgba = sampler.sample(&Query::new(0.3, 0.7, 0.01, 0.0, 0.0, 0.002));
+//! assert!(rgba.iter().all(|c| c.is_finite()));
+//! # Ok::<(), parvo::Error>(())
+//! ```
+
+mod aniso;
+mod batch;
+mod bilinear;
+pub mod ewa;
+pub mod fetch;
+pub mod footprint;
+pub mod plane;
+mod query;
+mod supersample;
+pub mod trace;
+mod trilinear;
+
+use std::fmt;
+use std::hash::{Hash, Hasher};
+use std::str::FromStr;
+use std::sync::Arc;
+
+use crate::error::{Error, Result};
+use crate::mip::MipChain;
+use crate::wrap::Wrap;
+
+pub use fetch::LinearChain;
+pub use footprint::{Footprint, footprint, mip_linear, mip_nearest};
+pub use query::Query;
+pub use trace::{NoTrace, TexelCounter, TexelRead, TexelRecorder, TexelSink};
+
+use fetch::Addressing;
+use trilinear::Iso;
+
+/// Filter names used on the command line and in reports (SPEC.md "Names
+/// used on the command line"). Each maps to a preset of
+/// [`SamplerOptions`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Filter {
+    /// Nearest texel, nearest mip level.
+    Nearest,
+    /// Bilinear within a level, nearest mip level (as games use the word).
+    Bilinear,
+    /// Bilinear in the two nearest levels, blended (8 texels).
+    Trilinear,
+    /// Footprint assembly: up to `max_aniso` trilinear probes.
+    Aniso,
+    /// Elliptical weighted average (Greene & Heckbert).
+    Ewa,
+    /// Box filter over the footprint's bounding box from a summed-area
+    /// table (the summed-area-table issue provides it).
+    Sat,
+    /// The supersampled reference.
+    Supersample,
+}
+
+impl Filter {
+    /// Every filter, in a stable order.
+    pub const ALL: [Filter; 7] = [
+        Filter::Nearest,
+        Filter::Bilinear,
+        Filter::Trilinear,
+        Filter::Aniso,
+        Filter::Ewa,
+        Filter::Sat,
+        Filter::Supersample,
+    ];
+
+    /// The stable name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Filter::Nearest => "nearest",
+            Filter::Bilinear => "bilinear",
+            Filter::Trilinear => "trilinear",
+            Filter::Aniso => "aniso",
+            Filter::Ewa => "ewa",
+            Filter::Sat => "sat",
+            Filter::Supersample => "supersample",
+        }
+    }
+}
+
+impl fmt::Display for Filter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Filter {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        let t = s.trim();
+        Filter::ALL
+            .into_iter()
+            .find(|f| f.name().eq_ignore_ascii_case(t))
+            .ok_or_else(|| {
+                Error::parse(
+                    "filter",
+                    s,
+                    "expected nearest, bilinear, trilinear, aniso, ewa, sat or supersample",
+                )
+            })
+    }
+}
+
+/// Filter within one mip level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum TexelFilter {
+    /// The texel containing the coordinate (1 texel).
+    Nearest,
+    /// Bilinear interpolation of the 2×2 nearest texel centres (4 texels).
+    #[default]
+    Linear,
+}
+
+impl fmt::Display for TexelFilter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            TexelFilter::Nearest => "nearest",
+            TexelFilter::Linear => "linear",
+        })
+    }
+}
+
+impl FromStr for TexelFilter {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "nearest" => Ok(TexelFilter::Nearest),
+            "linear" | "bilinear" => Ok(TexelFilter::Linear),
+            _ => Err(Error::parse(
+                "texel filter",
+                s,
+                "expected nearest or linear",
+            )),
+        }
+    }
+}
+
+/// How mip levels are chosen when minifying.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum MipMode {
+    /// No mipmapping: level 0 only.
+    None,
+    /// The nearest level (d = ceil(d' + 0.5) − 1).
+    Nearest,
+    /// Blend of the two nearest levels.
+    #[default]
+    Linear,
+}
+
+impl fmt::Display for MipMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            MipMode::None => "none",
+            MipMode::Nearest => "nearest",
+            MipMode::Linear => "linear",
+        })
+    }
+}
+
+impl FromStr for MipMode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "none" => Ok(MipMode::None),
+            "nearest" => Ok(MipMode::Nearest),
+            "linear" => Ok(MipMode::Linear),
+            _ => Err(Error::parse(
+                "mip mode",
+                s,
+                "expected none, nearest or linear",
+            )),
+        }
+    }
+}
+
+/// The algorithm behind a sampler.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Method {
+    /// The GPU sampler: magnification/minification filter, mip mode, and
+    /// footprint assembly when `max_aniso > 1` (nearest, bilinear,
+    /// trilinear, aniso).
+    #[default]
+    Texel,
+    /// Elliptical weighted average.
+    Ewa,
+    /// Summed-area table box filter (not built by this module yet:
+    /// [`Sampler::new`] refuses it).
+    Sat,
+    /// n × n supersampled reference at level 0.
+    Supersample,
+}
+
+/// Everything that decides how a lookup filters. `Copy`, `Eq` and `Hash`
+/// (floats compare by bit pattern) so it can key caches.
+///
+/// The default is trilinear: linear/linear/linear, no anisotropy, no bias,
+/// LOD clamp ±1000 (OpenGL's defaults), repeat, transparent black border.
+#[derive(Clone, Copy, Debug)]
+pub struct SamplerOptions {
+    /// Algorithm. Default: [`Method::Texel`].
+    pub method: Method,
+    /// Filter when magnifying (λ ≤ 0). Default: linear.
+    pub mag: TexelFilter,
+    /// Filter when minifying (λ > 0). Default: linear.
+    pub min: TexelFilter,
+    /// Mip level selection when minifying. Default: linear.
+    pub mip: MipMode,
+    /// Maximum anisotropy, 1 to 16 (1 = isotropic). Default: 1. Used by
+    /// footprint assembly (probe count) and EWA (minor-axis lengthening).
+    pub max_aniso: u32,
+    /// Added to λ before the clamp. Default: 0.
+    pub lod_bias: f32,
+    /// Lower LOD clamp. Default: −1000.
+    pub lod_min: f32,
+    /// Upper LOD clamp. Default: 1000.
+    pub lod_max: f32,
+    /// Wrap mode per axis. Default: repeat.
+    pub wrap: Wrap,
+    /// Colour read outside the level under `ClampToBorder`, linear RGBA.
+    /// Default: transparent black.
+    pub border: [f32; 4],
+    /// Grid size n of the supersampled reference (n × n lookups), 1 to 64.
+    /// Default: 8.
+    pub supersample: u32,
+}
+
+impl Default for SamplerOptions {
+    fn default() -> Self {
+        SamplerOptions {
+            method: Method::Texel,
+            mag: TexelFilter::Linear,
+            min: TexelFilter::Linear,
+            mip: MipMode::Linear,
+            max_aniso: 1,
+            lod_bias: 0.0,
+            lod_min: -1000.0,
+            lod_max: 1000.0,
+            wrap: Wrap::default(),
+            border: [0.0; 4],
+            supersample: 8,
+        }
+    }
+}
+
+impl SamplerOptions {
+    /// Nearest texel, nearest mip level.
+    pub fn nearest() -> Self {
+        SamplerOptions {
+            mag: TexelFilter::Nearest,
+            min: TexelFilter::Nearest,
+            mip: MipMode::Nearest,
+            ..Default::default()
+        }
+    }
+
+    /// Bilinear, nearest mip level.
+    pub fn bilinear() -> Self {
+        SamplerOptions {
+            mip: MipMode::Nearest,
+            ..Default::default()
+        }
+    }
+
+    /// Trilinear (the default).
+    pub fn trilinear() -> Self {
+        Self::default()
+    }
+
+    /// Trilinear footprint assembly with up to `max_aniso` probes (1–16).
+    pub fn aniso(max_aniso: u32) -> Self {
+        SamplerOptions {
+            max_aniso,
+            ..Default::default()
+        }
+    }
+
+    /// EWA with maximum anisotropy 16.
+    pub fn ewa() -> Self {
+        SamplerOptions {
+            method: Method::Ewa,
+            max_aniso: 16,
+            ..Default::default()
+        }
+    }
+
+    /// The summed-area-table box filter (see [`Method::Sat`]).
+    pub fn sat() -> Self {
+        SamplerOptions {
+            method: Method::Sat,
+            ..Default::default()
+        }
+    }
+
+    /// The supersampled reference with `n × n` lookups.
+    pub fn supersample(n: u32) -> Self {
+        SamplerOptions {
+            method: Method::Supersample,
+            supersample: n,
+            ..Default::default()
+        }
+    }
+
+    /// The preset behind a filter name; `max_aniso` is used by `aniso`
+    /// (and `ewa`), `supersample` by `supersample`.
+    pub fn preset(filter: Filter, max_aniso: u32) -> Self {
+        match filter {
+            Filter::Nearest => Self::nearest(),
+            Filter::Bilinear => Self::bilinear(),
+            Filter::Trilinear => Self::trilinear(),
+            Filter::Aniso => Self::aniso(max_aniso),
+            Filter::Ewa => SamplerOptions {
+                max_aniso,
+                ..Self::ewa()
+            },
+            Filter::Sat => Self::sat(),
+            Filter::Supersample => Self::supersample(8),
+        }
+    }
+
+    /// The name used in reports: `nearest`, `bilinear`, `trilinear`,
+    /// `aniso2`…`aniso16`, `ewa`, `sat`, `supersample`, or a description
+    /// of a non-preset combination (`mag-linear-min-nearest-mip-none`).
+    pub fn name(&self) -> String {
+        match self.method {
+            Method::Ewa => return "ewa".into(),
+            Method::Sat => return "sat".into(),
+            Method::Supersample => return "supersample".into(),
+            Method::Texel => {}
+        }
+        use TexelFilter::{Linear, Nearest};
+        match (self.mag, self.min, self.mip, self.max_aniso) {
+            (Linear, Linear, MipMode::Linear, n) if n > 1 => format!("aniso{n}"),
+            (Nearest, Nearest, MipMode::Nearest, 1) => "nearest".into(),
+            (Linear, Linear, MipMode::Nearest, 1) => "bilinear".into(),
+            (Linear, Linear, MipMode::Linear, 1) => "trilinear".into(),
+            (mag, min, mip, n) => {
+                let mut s = format!("mag-{mag}-min-{min}-mip-{mip}");
+                if n > 1 {
+                    s += &format!("-aniso{n}");
+                }
+                s
+            }
+        }
+    }
+
+    /// Check every field; [`Sampler::new`] calls this.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidOption(m));
+        if !(1..=16).contains(&self.max_aniso) {
+            return bad(format!("max anisotropy {} must be 1 to 16", self.max_aniso));
+        }
+        for (name, x) in [
+            ("LOD bias", self.lod_bias),
+            ("LOD min", self.lod_min),
+            ("LOD max", self.lod_max),
+        ] {
+            if !x.is_finite() {
+                return bad(format!("{name} {x} must be finite"));
+            }
+        }
+        if self.lod_min > self.lod_max {
+            return bad(format!(
+                "LOD min {} is above LOD max {}",
+                self.lod_min, self.lod_max
+            ));
+        }
+        if !self.border.iter().all(|c| c.is_finite()) {
+            return bad(format!("border colour {:?} must be finite", self.border));
+        }
+        if !(1..=64).contains(&self.supersample) {
+            return bad(format!(
+                "supersample grid {} must be 1 to 64",
+                self.supersample
+            ));
+        }
+        if self.method == Method::Sat {
+            return Err(sat_unavailable());
+        }
+        Ok(())
+    }
+
+    fn key(&self) -> impl PartialEq + Hash {
+        (
+            self.method,
+            self.mag,
+            self.min,
+            self.mip,
+            self.max_aniso,
+            [
+                self.lod_bias.to_bits(),
+                self.lod_min.to_bits(),
+                self.lod_max.to_bits(),
+            ],
+            self.wrap,
+            self.border.map(f32::to_bits),
+            self.supersample,
+        )
+    }
+}
+
+impl PartialEq for SamplerOptions {
+    fn eq(&self, other: &Self) -> bool {
+        self.key() == other.key()
+    }
+}
+
+impl Eq for SamplerOptions {}
+
+impl Hash for SamplerOptions {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        self.key().hash(state);
+    }
+}
+
+impl fmt::Display for SamplerOptions {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+/// What [`Sampler`] runs (validated options, `Sat` excluded).
+#[derive(Clone, Copy, Debug)]
+enum Kernel {
+    /// `Texel` with `max_aniso == 1`: η = 1, one probe, λ without roots.
+    Isotropic,
+    Texel,
+    Ewa,
+    Supersample,
+}
+
+/// A texture ready to be sampled with one set of options.
+///
+/// Building it decodes the chain to linear RGBA `f32` once
+/// ([`LinearChain`]); [`Sampler::from_linear`] shares a decoded chain
+/// between samplers. Lookups take `&self` and are safe to run from many
+/// threads.
+#[derive(Clone, Debug)]
+pub struct Sampler {
+    chain: Arc<LinearChain>,
+    options: SamplerOptions,
+    kernel: Kernel,
+    addr: Addressing,
+    iso: Iso,
+}
+
+impl Sampler {
+    /// Decode `chain` and check `options` (an [`Error::InvalidOption`] for
+    /// out-of-range values and for the `sat` filter, which needs a
+    /// summed-area table).
+    pub fn new(chain: &MipChain, options: SamplerOptions) -> Result<Self> {
+        options.validate()?;
+        Self::from_linear(Arc::new(LinearChain::new(chain)), options)
+    }
+
+    /// A sampler over an already decoded chain.
+    pub fn from_linear(chain: Arc<LinearChain>, options: SamplerOptions) -> Result<Self> {
+        options.validate()?;
+        let kernel = match options.method {
+            Method::Texel if options.max_aniso == 1 => Kernel::Isotropic,
+            Method::Texel => Kernel::Texel,
+            Method::Ewa => Kernel::Ewa,
+            Method::Supersample => Kernel::Supersample,
+            // `validate` has refused it already; kept as an error, not a panic.
+            Method::Sat => return Err(sat_unavailable()),
+        };
+        Ok(Sampler {
+            chain,
+            options,
+            kernel,
+            addr: Addressing {
+                wrap: options.wrap,
+                border: options.border,
+            },
+            iso: Iso {
+                mag: options.mag,
+                min: options.min,
+                mip: options.mip,
+            },
+        })
+    }
+
+    /// The options.
+    pub fn options(&self) -> &SamplerOptions {
+        &self.options
+    }
+
+    /// The decoded chain.
+    pub fn chain(&self) -> &Arc<LinearChain> {
+        &self.chain
+    }
+
+    /// LOD and anisotropy of `q` under these options.
+    pub fn footprint(&self, q: &Query) -> Footprint {
+        let l = &self.chain.levels[0];
+        footprint(q, l.w, l.h, &self.options)
+    }
+
+    /// Filtered linear RGBA colour at `q`.
+    #[inline]
+    pub fn sample(&self, q: &Query) -> [f32; 4] {
+        self.sample_traced(q, &mut NoTrace)
+    }
+
+    /// [`Sampler::sample`], reporting every texel read to `sink`.
+    #[inline]
+    pub fn sample_traced<S: TexelSink>(&self, q: &Query, sink: &mut S) -> [f32; 4] {
+        let levels = &self.chain.levels[..];
+        let u = coord(q.u);
+        let v = coord(q.v);
+        match self.kernel {
+            Kernel::Isotropic => {
+                let l = &levels[0];
+                let lambda = footprint::isotropic_lambda(q, l.wf, l.hf, &self.options);
+                trilinear::isotropic(levels, self.iso, &self.addr, u, v, lambda, sink)
+            }
+            Kernel::Texel => {
+                let l = &levels[0];
+                let fp = footprint(q, l.w, l.h, &self.options);
+                aniso::anisotropic(levels, self.iso, &self.addr, u, v, &fp, sink)
+            }
+            Kernel::Ewa => {
+                let (dx, dy) = footprint::derivatives(q, levels[0].wf, levels[0].hf);
+                ewa::ewa(
+                    levels,
+                    &self.addr,
+                    self.options.mip,
+                    self.options.max_aniso,
+                    &self.options,
+                    u,
+                    v,
+                    dx,
+                    dy,
+                    sink,
+                )
+            }
+            Kernel::Supersample => {
+                let (dx, dy) = footprint::derivatives(q, levels[0].wf, levels[0].hf);
+                supersample::supersample(
+                    levels,
+                    &self.addr,
+                    self.options.supersample,
+                    u,
+                    v,
+                    dx,
+                    dy,
+                    sink,
+                )
+            }
+        }
+    }
+}
+
+fn sat_unavailable() -> Error {
+    Error::InvalidOption(
+        "the sat filter needs a summed-area table, which this sampler does not build yet \
+         (it arrives with the summed-area-table module)"
+            .into(),
+    )
+}
+
+/// A query coordinate as `f64`, NaN read as 0.
+#[inline(always)]
+fn coord(x: f32) -> f64 {
+    if x.is_nan() { 0.0 } else { x as f64 }
+}

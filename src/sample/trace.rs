@@ -1,0 +1,79 @@
+//! Texel tracing: every filter reports each texel it reads.
+//!
+//! The samplers are generic over a [`TexelSink`]. [`NoTrace`] has an empty,
+//! always-inlined method, so `Sampler::sample` (which uses it) compiles to
+//! the same code as an untraced sampler would; the `sample` benchmark
+//! compares it against a counting sink. [`TexelRecorder`] keeps every read
+//! in order (what the cache simulator replays); [`TexelCounter`] only
+//! counts them (tests use it to bound the work per query).
+//!
+//! Reads of the border colour (`ClampToBorder` outside the level) touch no
+//! texel memory and are not reported.
+
+/// Receives every texel a filter reads, in read order.
+pub trait TexelSink {
+    /// Texel `(x, y)` of mip level `level` was read (`x`, `y` in range).
+    fn texel(&mut self, level: u32, x: u32, y: u32);
+}
+
+impl<S: TexelSink + ?Sized> TexelSink for &mut S {
+    #[inline(always)]
+    fn texel(&mut self, level: u32, x: u32, y: u32) {
+        (**self).texel(level, x, y);
+    }
+}
+
+/// The sink that ignores everything (compiles away).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoTrace;
+
+impl TexelSink for NoTrace {
+    #[inline(always)]
+    fn texel(&mut self, _level: u32, _x: u32, _y: u32) {}
+}
+
+/// One texel read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct TexelRead {
+    /// Mip level (0 = full resolution).
+    pub level: u32,
+    /// Column within the level.
+    pub x: u32,
+    /// Row within the level.
+    pub y: u32,
+}
+
+/// Records every read in order.
+#[derive(Clone, Debug, Default)]
+pub struct TexelRecorder {
+    /// The reads so far.
+    pub reads: Vec<TexelRead>,
+}
+
+impl TexelRecorder {
+    /// An empty recorder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+impl TexelSink for TexelRecorder {
+    #[inline]
+    fn texel(&mut self, level: u32, x: u32, y: u32) {
+        self.reads.push(TexelRead { level, x, y });
+    }
+}
+
+/// Counts reads.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TexelCounter {
+    /// Texels read so far.
+    pub count: u64,
+}
+
+impl TexelSink for TexelCounter {
+    #[inline(always)]
+    fn texel(&mut self, _level: u32, _x: u32, _y: u32) {
+        self.count += 1;
+    }
+}
