@@ -7,6 +7,8 @@
 //!                      │ mip::build(MipOptions)
 //!                      ▼
 //!                   MipChain (levels in the source format)
+//!
+//! Texture ──sat::build(accumulator)──▶ SummedAreaTable ──▶ SatSampler
 //! ```
 //!
 //! - [`texel`]: formats (1–4 channels; u8, u16, f16, f32; linear or sRGB;
@@ -20,6 +22,8 @@
 //! - [`mip`]: level sizes, kernels, polyphase weights, the separable
 //!   reference path and the fast box paths, alpha coverage and normal
 //!   renormalisation, the chain builder.
+//! - [`sat`]: summed-area tables with exact integer or bounded-error float
+//!   accumulators, O(1) box sums under every wrap mode, the SAT sampler.
 //!
 //! The library never prints and never panics on bad input: errors are
 //! [`Error`] values, long builds report through a progress callback.
@@ -38,12 +42,14 @@
 pub mod builtin;
 pub mod error;
 pub mod mip;
+pub mod sat;
 pub mod texel;
 pub mod texture;
 pub mod wrap;
 
 pub use error::{Error, Result};
 pub use mip::{MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
+pub use sat::{AccumulatorKind, SatSampler, SummedAreaTable};
 pub use texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 pub use texture::Texture;
 pub use wrap::{Wrap, WrapMode};
