@@ -67,7 +67,7 @@ mod sampler;
 mod table;
 
 pub use accum::{Accumulator, AccumulatorKind, OffsetF32};
-pub use sampler::SatSampler;
+pub use sampler::{EXTENT_LIMIT, SatSampler};
 pub use table::{BoxSum, SummedAreaTable, Units};
 
 use crate::error::Result;

@@ -175,6 +175,7 @@ impl SatSampler {
             sum: [0.0; 4],
             area: 0.0,
             border: 0.0,
+            error: 0.0,
         };
         for k in 0..n {
             let s = (k as f64 + 0.5) / nf - 0.5;
@@ -186,6 +187,7 @@ impl SatSampler {
             }
             total.area += b.area;
             total.border += b.border;
+            total.error += b.error;
         }
         let avg = self.table.finish(&total, self.border);
         expand_to_rgba(&avg[..self.channels])

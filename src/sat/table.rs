@@ -35,6 +35,10 @@ pub struct BoxSum {
     pub area: f64,
     /// Part of `area` that reads the border colour (clamp to border).
     pub border: f64,
+    /// Bound on the absolute error of each entry of `sum` (stored units):
+    /// `Σ|coefficient| · max_entry_error` plus the rounding of combining the
+    /// reads; 0 for integer tables read with whole-texel coefficients.
+    pub error: f64,
 }
 
 /// A summed-area table of one level, all channels (Crow 1984; SPEC.md
@@ -399,12 +403,19 @@ impl<A: Accumulator> SummedAreaTable<A> {
     fn combine(&self, ax: &Axis, ay: &Axis) -> BoxSum {
         let ch = self.channels;
         let mut sum = [0f64; 4];
+        let mut weight = 0.0;
+        let mut magnitude = 0f64;
+        let mut whole = true;
         for (iy, cy) in ay.terms() {
             for (ix, cx) in ax.terms() {
                 let k = cx * cy;
+                weight += k.abs();
+                whole &= k.fract() == 0.0;
                 let p = self.at(ix, iy);
                 for (c, s) in sum.iter_mut().enumerate().take(ch) {
-                    *s += k * self.data[p + c].to_f64();
+                    let term = k * self.data[p + c].to_f64();
+                    magnitude = magnitude.max(term.abs());
+                    *s += term;
                 }
             }
         }
@@ -415,10 +426,21 @@ impl<A: Accumulator> SummedAreaTable<A> {
             }
         }
         let area = ax.total * ay.total;
+        // Combining n terms in f64 rounds at most n times, each by at most
+        // 2⁻⁵³ of the largest partial sum (bounded by n·magnitude); integer
+        // tables with whole-texel rectangles combine exactly.
+        let n = (ax.len * ay.len) as f64;
+        let exact = A::KIND.is_integer() && whole && magnitude < 2f64.powi(53);
+        let combine = if exact {
+            0.0
+        } else {
+            n * n * magnitude * f64::EPSILON
+        };
         BoxSum {
             sum,
             area,
             border: (area - inside).max(0.0),
+            error: weight * self.entry_error + combine,
         }
     }
 
@@ -461,7 +483,9 @@ impl<A: Accumulator> SummedAreaTable<A> {
         for c in 0..ch {
             out[c] = match weighted {
                 Some(a) if c != a => {
-                    if total[a] > 0.0 {
+                    // Covered alpha indistinguishable from 0 (within the
+                    // query's error bound): transparent, colour 0.
+                    if total[a] > s.error.max(ALPHA_EPS * s.area * u) {
                         (total[c] / (total[a] * u)) as f32
                     } else {
                         0.0
@@ -473,6 +497,10 @@ impl<A: Accumulator> SummedAreaTable<A> {
         out
     }
 }
+
+/// Average alpha below this counts as zero when dividing colour by alpha
+/// (the mip builder's threshold).
+const ALPHA_EPS: f64 = 1e-7;
 
 /// Border colour (linear RGBA) in the texture's channel layout.
 fn border_channels(b: [f32; 4], ch: usize) -> [f32; 4] {
