@@ -21,7 +21,7 @@ const REGION: u32 = 64;
 const SIZES: [u32; 4] = [1, 2, 3, 4];
 
 fn main() -> parvo::Result<()> {
-    let mut s = 0x5EED_5A7u64;
+    let mut s = 0x05EE_D5A7_u64;
     let values: Vec<f32> = (0..N * N)
         .map(|_| {
             // splitmix64

@@ -12,7 +12,7 @@ const REGION: u32 = 24;
 
 #[test]
 fn f64_beats_offset_f32_beats_f32_near_the_far_corner() {
-    let mut s = 0x5EED_5A7u64;
+    let mut s = 0x05EE_D5A7_u64;
     let values: Vec<f32> = (0..N * N)
         .map(|_| {
             s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
@@ -55,8 +55,8 @@ fn f64_beats_offset_f32_beats_f32_near_the_far_corner() {
         }
         errors.push(per_size);
     }
-    for k in 0..4 {
-        let (f32e, off, f64e) = (errors[0][k], errors[1][k], errors[2][k]);
+    for (k, ((&f32e, &off), &f64e)) in errors[0].iter().zip(&errors[1]).zip(&errors[2]).enumerate()
+    {
         assert!(
             f64e < off && off < f32e,
             "{k}: f32 {f32e} offset {off} f64 {f64e}"

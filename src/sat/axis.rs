@@ -20,8 +20,10 @@
 //! linearly). The interval is `C(x1) − C(x0)`: at most a handful of terms,
 //! whatever the length, so a footprint a million periods wide costs what a
 //! small one does. The integer coefficients of both ends are merged in
-//! `i128` before they become floats, so two huge nearly equal period counts
-//! cancel exactly instead of in floating point.
+//! `i64` (coordinates are at most 2⁵² texels, so they cannot overflow)
+//! before they become floats, so two huge nearly equal period counts cancel
+//! exactly instead of in floating point. Rectangles inside the level take a
+//! shortcut: the four reads of each end, nothing to wrap.
 
 use crate::wrap::{WrapMode, floor_index, wrap_index};
 
@@ -41,12 +43,12 @@ pub(crate) struct Axis {
 
 struct IntTerms {
     idx: [u32; N],
-    coef: [i128; N],
+    coef: [i64; N],
     len: usize,
 }
 
 impl IntTerms {
-    fn push(&mut self, idx: i64, c: i128) {
+    fn push(&mut self, idx: i64, c: i64) {
         // P[0] = 0: the term vanishes.
         if idx == 0 || c == 0 {
             return;
@@ -62,32 +64,32 @@ impl IntTerms {
     }
 
     /// Clamp-to-edge cumulative function.
-    fn clamp_edge(&mut self, x: i64, n: i64, sign: i128) {
+    fn clamp_edge(&mut self, x: i64, n: i64, sign: i64) {
         if x < 0 {
-            self.push(1, sign * x as i128);
+            self.push(1, sign * x);
         } else if x <= n {
             self.push(x, sign);
         } else {
-            let beyond = (x - n) as i128;
+            let beyond = x - n;
             self.push(n, sign * (1 + beyond));
             self.push(n - 1, -sign * beyond);
         }
     }
 
-    fn cumulative(&mut self, mode: WrapMode, x: i64, n: i64, sign: i128) {
+    fn cumulative(&mut self, mode: WrapMode, x: i64, n: i64, sign: i64) {
         match mode {
             WrapMode::Repeat => {
                 let (q, r) = (x.div_euclid(n), x.rem_euclid(n));
-                self.push(n, sign * q as i128);
+                self.push(n, sign * q);
                 self.push(r, sign);
             }
             WrapMode::MirroredRepeat => {
                 let (q, r) = (x.div_euclid(2 * n), x.rem_euclid(2 * n));
                 if r <= n {
-                    self.push(n, sign * 2 * q as i128);
+                    self.push(n, sign * 2 * q);
                     self.push(r, sign);
                 } else {
-                    self.push(n, sign * (2 * q as i128 + 2));
+                    self.push(n, sign * (2 * q + 2));
                     self.push(2 * n - r, -sign);
                 }
             }
@@ -106,11 +108,14 @@ impl IntTerms {
 
 impl Axis {
     /// The interval `[x0, x1)` (texel units, `x0 ≤ x1`, both finite and
-    /// within ±2^62) of an axis of `n ≥ 1` texels under `mode`.
+    /// within ±2⁵²) of an axis of `n ≥ 1` texels under `mode`.
     pub(crate) fn new(mode: WrapMode, x0: f64, x1: f64, n: u32) -> Axis {
         let n64 = n as i64;
         let (i0, i1) = (floor_index(x0), floor_index(x1));
         let (a0, a1) = (frac(x0, i0), frac(x1, i1));
+        if i0 >= 0 && (i1 < n64 || (i1 == n64 && a1 == 0.0)) {
+            return Self::inside(x0, x1, i0, a0, i1, a1);
+        }
         let mut it = IntTerms {
             idx: [0; N],
             coef: [0; N],
@@ -122,7 +127,7 @@ impl Axis {
             idx: [0; N],
             coef: [0.0; N],
             len: 0,
-            total: (i1 as i128 - i0 as i128) as f64 + (a1 - a0),
+            total: (i1 - i0) as f64 + (a1 - a0),
             inside: 0.0,
         };
         for k in 0..it.len {
@@ -142,6 +147,27 @@ impl Axis {
         } else {
             ax.total
         };
+        ax
+    }
+
+    /// `[x0, x1)` within `[0, n]`: `C(i + a) = (1 − a)·P[i] + a·P[i+1]` at
+    /// both ends, no wrapping (duplicate indices are left unmerged).
+    #[inline]
+    fn inside(x0: f64, x1: f64, i0: i64, a0: f64, i1: i64, a1: f64) -> Axis {
+        let mut ax = Axis {
+            idx: [0; N],
+            coef: [0.0; N],
+            len: 0,
+            total: x1 - x0,
+            inside: x1 - x0,
+        };
+        for (i, c) in [(i1, 1.0 - a1), (i1 + 1, a1), (i0, a0 - 1.0), (i0 + 1, -a0)] {
+            if i != 0 && c != 0.0 {
+                ax.idx[ax.len] = i as u32;
+                ax.coef[ax.len] = c;
+                ax.len += 1;
+            }
+        }
         ax
     }
 

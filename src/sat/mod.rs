@@ -92,7 +92,7 @@ pub struct Rect {
 
 /// Coordinates beyond this magnitude (in texels) are clamped to it: below
 /// 2⁵² an f64 still resolves whole texels, and every index stays exact in
-/// the i64/i128 arithmetic of the queries.
+/// the i64 arithmetic of the queries.
 pub const COORD_LIMIT: f64 = (1u64 << 52) as f64;
 
 impl Rect {

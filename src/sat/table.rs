@@ -134,6 +134,73 @@ impl Prepared<'_> {
         }
     }
 
+    /// Table row for level row `y`: `carry` (running column sums,
+    /// `(w+1)·ch`) gains the row's prefix sums and is stored into `dst`.
+    /// Plain sources are read in place; alpha-weighted ones go through
+    /// `buf`.
+    #[inline]
+    fn accumulate<A: Accumulator>(
+        &self,
+        y: usize,
+        buf: &mut [A::Wide],
+        carry: &mut [A::Wide],
+        dst: &mut [A],
+    ) {
+        let n = self.w * self.ch;
+        let off = self.offset;
+        match (&self.src, self.alpha) {
+            (Source::U8(v), None) => accumulate_row::<u8, A>(
+                &v[y * n..][..n],
+                |c, _| A::from_code(c as u32),
+                carry,
+                dst,
+                self.ch,
+            ),
+            (Source::U16(v), None) => accumulate_row::<u16, A>(
+                &v[y * n..][..n],
+                |c, _| A::from_code(c as u32),
+                carry,
+                dst,
+                self.ch,
+            ),
+            (Source::Linear(v), None) => accumulate_row::<f32, A>(
+                &v[y * n..][..n],
+                |x, c| A::from_linear(x as f64 - off[c]),
+                carry,
+                dst,
+                self.ch,
+            ),
+            _ => {
+                self.row::<A>(y, buf);
+                accumulate_row::<A::Wide, A>(buf, |x, _| x, carry, dst, self.ch);
+            }
+        }
+    }
+
+    /// `tot[i] += summand i of row y` (w·ch column totals).
+    #[inline]
+    fn add_to_totals<A: Accumulator>(&self, y: usize, buf: &mut [A::Wide], tot: &mut [A::Wide]) {
+        let n = self.w * self.ch;
+        match (&self.src, self.alpha) {
+            (Source::U8(v), None) => {
+                for (t, &c) in tot.iter_mut().zip(&v[y * n..][..n]) {
+                    *t = A::add(*t, A::from_code(c as u32));
+                }
+            }
+            (Source::U16(v), None) => {
+                for (t, &c) in tot.iter_mut().zip(&v[y * n..][..n]) {
+                    *t = A::add(*t, A::from_code(c as u32));
+                }
+            }
+            _ => {
+                self.row::<A>(y, buf);
+                for (t, &v) in tot.iter_mut().zip(buf.iter()) {
+                    *t = A::add(*t, v);
+                }
+            }
+        }
+    }
+
     /// Per-channel sum of `|summand|` and of the summand (float sources).
     fn float_sums(&self, h: usize) -> ([f64; 4], [f64; 4]) {
         let ch = self.ch;
@@ -250,7 +317,6 @@ impl<A: Accumulator> SummedAreaTable<A> {
             };
             (prep, unit)
         } else {
-            first_non_finite(tex)?;
             let lin = match tex.texels() {
                 Texels::F32(v) if fmt.color_space == ColorSpace::Linear => Cow::Borrowed(&v[..]),
                 _ => Cow::Owned(tex.to_linear()),
@@ -269,6 +335,15 @@ impl<A: Accumulator> SummedAreaTable<A> {
         let mut sum_abs = [0.0; 4];
         if !kind.is_integer() {
             let (abs, sum) = prep.float_sums(h);
+            if abs.iter().any(|a| !a.is_finite()) {
+                // Only NaN or ±Inf input makes these sums non-finite (finite
+                // f32 sums stay below 2¹²⁸·2⁶⁴); find the first for the error.
+                first_non_finite(tex)?;
+                return Err(Error::InvalidOption(
+                    "finite texels decode to infinite linear values (sRGB beyond the f32 range)"
+                        .into(),
+                ));
+            }
             sum_abs = abs;
             if kind == AccumulatorKind::OffsetF32 {
                 let n = (w * h) as f64;
@@ -279,10 +354,15 @@ impl<A: Accumulator> SummedAreaTable<A> {
         }
         let data = build_bands::<A>(&prep, w, h, ch);
         if !kind.is_integer() {
-            let max_entry = data
-                .par_iter()
-                .map(|e| e.to_f64().abs())
-                .reduce(|| 0.0, f64::max);
+            // f64 entries cannot overflow (see above) and are not rounded
+            // again when stored: only f32 kinds need their largest entry.
+            let max_entry = if kind == AccumulatorKind::F64 {
+                0.0
+            } else {
+                data.par_iter()
+                    .map(|e| e.to_f64().abs())
+                    .reduce(|| 0.0, f64::max)
+            };
             if max_entry.is_infinite() {
                 return Err(Error::InvalidOption(format!(
                     "the sums of this texture exceed the {kind} range; use an f64 table"
@@ -531,10 +611,7 @@ fn build_bands<A: Accumulator>(p: &Prepared<'_>, w: usize, h: usize, ch: usize) 
             let mut tot = vec![A::Wide::default(); w * ch];
             let mut row = vec![A::Wide::default(); w * ch];
             for y in b * band_rows..((b + 1) * band_rows).min(h) {
-                p.row::<A>(y, &mut row);
-                for (t, &v) in tot.iter_mut().zip(&row) {
-                    *t = A::add(*t, v);
-                }
+                p.add_to_totals::<A>(y, &mut row, &mut tot);
             }
             tot
         })
@@ -567,18 +644,19 @@ fn build_bands<A: Accumulator>(p: &Prepared<'_>, w: usize, h: usize, ch: usize) 
         .for_each(|(b, (out, mut carry))| {
             let mut row = vec![A::Wide::default(); w * ch];
             for (k, dst) in out.chunks_exact_mut(stride).enumerate() {
-                p.row::<A>(b * band_rows + k, &mut row);
-                accumulate_row::<A>(&row, &mut carry, dst, ch);
+                p.accumulate::<A>(b * band_rows + k, &mut row, &mut carry, dst);
             }
         });
     data
 }
 
-/// One table row: `carry` (running column sums, `(w+1)·ch`) gains this
-/// row's prefix sums and is stored into `dst`.
-#[inline]
-fn accumulate_row<A: Accumulator>(
-    row: &[A::Wide],
+/// One table row: `carry` (running column sums, `(w+1)·ch`) gains the
+/// prefix sums of `src` (converted by `conv(value, channel)`) and is
+/// stored into `dst`.
+#[inline(always)]
+fn accumulate_row<T: Copy, A: Accumulator>(
+    src: &[T],
+    conv: impl Fn(T, usize) -> A::Wide,
     carry: &mut [A::Wide],
     dst: &mut [A],
     ch: usize,
@@ -586,21 +664,21 @@ fn accumulate_row<A: Accumulator>(
     match ch {
         1 => {
             let mut run = A::Wide::default();
-            for ((&v, c), d) in row.iter().zip(&mut carry[1..]).zip(&mut dst[1..]) {
-                run = A::add(run, v);
+            for ((&v, c), d) in src.iter().zip(&mut carry[1..]).zip(&mut dst[1..]) {
+                run = A::add(run, conv(v, 0));
                 *c = A::add(*c, run);
                 *d = A::store(*c);
             }
         }
         _ => {
             let mut run = [A::Wide::default(); 4];
-            for ((v, c), d) in row
+            for ((v, c), d) in src
                 .chunks_exact(ch)
                 .zip(carry[ch..].chunks_exact_mut(ch))
                 .zip(dst[ch..].chunks_exact_mut(ch))
             {
                 for k in 0..ch {
-                    run[k] = A::add(run[k], v[k]);
+                    run[k] = A::add(run[k], conv(v[k], k));
                     c[k] = A::add(c[k], run[k]);
                     d[k] = A::store(c[k]);
                 }
