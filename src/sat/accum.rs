@@ -153,7 +153,7 @@ pub trait Accumulator:
 }
 
 macro_rules! int_acc {
-    ($t:ty, $kind:ident) => {
+    ($t:ty, $kind:ident, $to_f64:expr) => {
         impl Accumulator for $t {
             const KIND: AccumulatorKind = AccumulatorKind::$kind;
             type Wide = $t;
@@ -177,7 +177,7 @@ macro_rules! int_acc {
             }
             #[inline(always)]
             fn to_f64(self) -> f64 {
-                self as f64
+                $to_f64(self)
             }
             #[inline(always)]
             fn sub(self, o: $t) -> $t {
@@ -191,9 +191,19 @@ macro_rules! int_acc {
     };
 }
 
-int_acc!(u32, U32);
-int_acc!(u64, U64);
-int_acc!(u128, U128);
+int_acc!(u32, U32, |v: u32| v as f64);
+// Through i64 when the top bit is clear: a single instruction on x86-64,
+// where the unsigned conversion takes a dozen.
+int_acc!(u64, U64, |v: u64| if v >> 63 == 0 {
+    v as i64 as f64
+} else {
+    v as f64
+});
+int_acc!(u128, U128, |v: u128| if v >> 63 == 0 {
+    v as i64 as f64
+} else {
+    v as f64
+});
 
 macro_rules! float_acc {
     ($t:ty, $kind:ident, $store:expr, $get:expr) => {

@@ -57,6 +57,8 @@ pub struct SummedAreaTable<A: Accumulator> {
     offset: [f64; 4],
     units: Units,
     entry_error: f64,
+    /// Upper bound on |entry| (stored units), for the combination error.
+    max_abs: f64,
 }
 
 /// The values a table sums, one row at a time.
@@ -332,6 +334,7 @@ impl<A: Accumulator> SummedAreaTable<A> {
         };
         let mut prep = prep;
         let mut entry_error = 0.0;
+        let max_abs;
         let mut sum_abs = [0.0; 4];
         if !kind.is_integer() {
             let (abs, sum) = prep.float_sums(h);
@@ -380,6 +383,13 @@ impl<A: Accumulator> SummedAreaTable<A> {
             let total_abs = sum_abs.iter().fold(0.0f64, |m, &s| m.max(s));
             entry_error =
                 2.0 * (w + h) as f64 * u64 * total_abs * (1.0 + store) + store * max_entry;
+            max_abs = max_entry.max(total_abs) + entry_error;
+        } else {
+            // Non-negative summands: the far corner holds each channel's
+            // largest entry.
+            max_abs = data[data.len() - ch..]
+                .iter()
+                .fold(0.0f64, |m, e| m.max(e.to_f64()));
         }
         Ok(SummedAreaTable {
             width: tex.width(),
@@ -392,6 +402,7 @@ impl<A: Accumulator> SummedAreaTable<A> {
                 alpha_weighted: alpha,
             },
             entry_error,
+            max_abs,
         })
     }
 
@@ -481,24 +492,20 @@ impl<A: Accumulator> SummedAreaTable<A> {
     }
 
     fn combine(&self, ax: &Axis, ay: &Axis) -> BoxSum {
-        let ch = self.channels;
-        let mut sum = [0f64; 4];
-        let mut weight = 0.0;
-        let mut magnitude = 0f64;
-        let mut whole = true;
-        for (iy, cy) in ay.terms() {
-            for (ix, cx) in ax.terms() {
-                let k = cx * cy;
-                weight += k.abs();
-                whole &= k.fract() == 0.0;
-                let p = self.at(ix, iy);
-                for (c, s) in sum.iter_mut().enumerate().take(ch) {
-                    let term = k * self.data[p + c].to_f64();
-                    magnitude = magnitude.max(term.abs());
-                    *s += term;
-                }
-            }
-        }
+        let sum = match self.channels {
+            1 => widen(self.combine_n::<1>(ax, ay)),
+            2 => widen(self.combine_n::<2>(ax, ay)),
+            3 => widen(self.combine_n::<3>(ax, ay)),
+            _ => widen(self.combine_n::<4>(ax, ay)),
+        };
+        let mut sum = sum;
+        let integral = |a: &Axis| a.terms().all(|(_, c)| c == (c as i64) as f64);
+        let whole = integral(ax) && integral(ay);
+        let weight: f64 = {
+            let wx: f64 = ax.terms().map(|(_, c)| c.abs()).sum();
+            let wy: f64 = ay.terms().map(|(_, c)| c.abs()).sum();
+            wx * wy
+        };
         let inside = ax.inside * ay.inside;
         if A::KIND == AccumulatorKind::OffsetF32 {
             for (s, o) in sum.iter_mut().zip(self.offset) {
@@ -506,15 +513,16 @@ impl<A: Accumulator> SummedAreaTable<A> {
             }
         }
         let area = ax.total * ay.total;
-        // Combining n terms in f64 rounds at most n times, each by at most
-        // 2⁻⁵³ of the largest partial sum (bounded by n·magnitude); integer
+        // Combining n products in f64 rounds at most 2n times, each by at
+        // most 2⁻⁵³ of a partial sum, itself at most Σ|k|·max|S|; integer
         // tables with whole-texel rectangles combine exactly.
         let n = (ax.len * ay.len) as f64;
-        let exact = A::KIND.is_integer() && whole && magnitude < 2f64.powi(53);
+        let partial = weight * self.max_abs;
+        let exact = A::KIND.is_integer() && whole && partial < 2f64.powi(53);
         let combine = if exact {
             0.0
         } else {
-            n * n * magnitude * f64::EPSILON
+            2.0 * n * partial * (f64::EPSILON / 2.0)
         };
         BoxSum {
             sum,
@@ -522,6 +530,27 @@ impl<A: Accumulator> SummedAreaTable<A> {
             border: (area - inside).max(0.0),
             error: weight * self.entry_error + combine,
         }
+    }
+
+    /// `Σ_y cy · Σ_x cx · S(x, y)` per channel, `C` channels in registers.
+    #[inline(always)]
+    fn combine_n<const C: usize>(&self, ax: &Axis, ay: &Axis) -> [f64; C] {
+        let stride = (self.width as usize + 1) * C;
+        let mut sum = [0f64; C];
+        for (iy, cy) in ay.terms() {
+            let row = &self.data[iy as usize * stride..][..stride];
+            let mut acc = [0f64; C];
+            for (ix, cx) in ax.terms() {
+                let e = &row[ix as usize * C..][..C];
+                for c in 0..C {
+                    acc[c] += cx * e[c].to_f64();
+                }
+            }
+            for c in 0..C {
+                sum[c] += cy * acc[c];
+            }
+        }
+        sum
     }
 
     /// Average linear value per channel over `rect` under `wrap`
@@ -576,6 +605,12 @@ impl<A: Accumulator> SummedAreaTable<A> {
         }
         out
     }
+}
+
+/// `[f64; C]` padded to four channels.
+#[inline(always)]
+fn widen<const C: usize>(v: [f64; C]) -> [f64; 4] {
+    std::array::from_fn(|c| if c < C { v[c] } else { 0.0 })
 }
 
 /// Average alpha below this counts as zero when dividing colour by alpha
