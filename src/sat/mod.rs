@@ -25,6 +25,21 @@
 //! that. [`SummedAreaTable::max_entry_error`] gives each float table's
 //! bound, computed from its own data.
 //!
+//! Measured on a 4096² image of uniform random f32 values in [0, 1), the
+//! largest absolute error of box averages with a corner in the last 64×64
+//! texels (`cargo run --release --example 03_sat_precision`, which prints
+//! this table):
+//!
+//! | accumulator | 1×1 | 2×2 | 4×4 | 1×1 near the origin | stated bound, 1×1 |
+//! |---|---|---|---|---|---|
+//! | f32 | 9.1e-1 | 2.3e-1 | 5.3e-2 | 2.1e-4 | 2.0 |
+//! | offset-f32 | 3.2e-5 | 6.9e-6 | 1.9e-6 | 2.0e-6 | 4.3e-4 |
+//! | f64 | 9.3e-10 | 2.3e-10 | 5.8e-11 | 0 | 6.1e-5 |
+//!
+//! Subtracting the mean makes an f32 table about 30 000 times more
+//! accurate at the far corner for the same memory; f64 costs twice the
+//! memory and is another 30 000 times better.
+//!
 //! # Automatic choice
 //!
 //! [`choose`] takes the narrowest integer accumulator that SPEC's bit rule
@@ -53,6 +68,28 @@
 //! Clamp modes and the border colour are handled the same way (see the
 //! `axis` module). [`SatSampler`] averages the axis-aligned bounding box of
 //! a pixel footprint (SPEC "Coordinates") on level 0.
+//!
+//! # Example
+//!
+//! ```
+//! use parvo::sat::{self, AccumulatorKind, Rect};
+//! use parvo::texel::{ChannelType, ColorSpace, Format};
+//! use parvo::{Texture, Wrap, WrapMode};
+//!
+//! let grey = Format::new(1, ChannelType::U8, ColorSpace::Linear);
+//! let tex = Texture::from_u8(4, 2, grey, vec![0, 51, 102, 153, 204, 255, 0, 51])?;
+//! let table = sat::build(&tex, None)?; // 8 + 3 bits: u32 is exact
+//! assert_eq!(table.kind(), AccumulatorKind::U32);
+//! // Texels 1..3 of row 0, and the same columns one period to the left.
+//! let a = table.average(Rect::texels(1, 0, 3, 1), Wrap::default(), [0.0; 4]);
+//! let b = table.average(Rect::texels(-3, 0, -1, 1), Wrap::default(), [0.0; 4]);
+//! assert_eq!((a[0], b[0]), (0.3, 0.3));
+//! // Half of texel 3 and half of texel 0, across the edge, mirrored and not.
+//! let r = Rect::new(3.5, 0.0, 4.5, 1.0);
+//! assert_eq!(table.average(r, Wrap::default(), [0.0; 4])[0], 0.3);
+//! assert_eq!(table.average(r, Wrap::both(WrapMode::MirroredRepeat), [0.0; 4])[0], 0.6);
+//! # Ok::<(), parvo::Error>(())
+//! ```
 //!
 //! # Build
 //!
