@@ -279,3 +279,16 @@ fn anisotropic_slices_beat_one_box_on_diagonal_footprints() {
     println!("mean abs error vs parallelogram: 1 box {e1:.4}, up to 16 slices {e8:.4}");
     assert!(e8 < 0.5 * e1, "aniso {e8} vs single {e1}");
 }
+
+#[test]
+fn anisotropic_slices_of_an_axis_aligned_footprint_tile_its_box() {
+    let tex = small_rgba();
+    let s = SatSampler::new(&tex, Wrap::default(), [0.0; 4]).unwrap();
+    for (dudx, dvdy) in [(0.5f32, 0.0625f32), (0.03, 0.4), (2.5, 0.01)] {
+        let one = s.sample(0.3, 0.6, dudx, 0.0, 0.0, dvdy);
+        let many = s.sample_aniso(0.3, 0.6, dudx, 0.0, 0.0, dvdy, 16);
+        for c in 0..4 {
+            assert!((one[c] - many[c]).abs() < 1e-5, "{one:?} vs {many:?}");
+        }
+    }
+}
