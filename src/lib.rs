@@ -11,6 +11,8 @@
 //!                      ▼
 //! Query{uv, derivatives} ──▶ Footprint (λ, η) ──▶ filter ──▶ [f32; 4]
 //!                                                   └──▶ TexelSink (every texel read)
+//!
+//! Texture ──sat::build(accumulator)──▶ SummedAreaTable ──▶ SatSampler
 //! ```
 //!
 //! - [`texel`]: formats (1–4 channels; u8, u16, f16, f32; linear or sRGB;
@@ -27,6 +29,8 @@
 //! - [`sample`]: [`SamplerOptions`], [`Query`], the footprint (LOD,
 //!   anisotropy) and the filters from nearest to EWA, generic over a
 //!   [`TexelSink`] that sees every texel read; batch sampling on rayon.
+//! - [`sat`]: summed-area tables with exact integer or bounded-error float
+//!   accumulators, O(1) box sums under every wrap mode, the SAT sampler.
 //!
 //! The library never prints and never panics on bad input: errors are
 //! [`Error`] values, long builds report through a progress callback.
@@ -46,6 +50,7 @@ pub mod builtin;
 pub mod error;
 pub mod mip;
 pub mod sample;
+pub mod sat;
 pub mod texel;
 pub mod texture;
 pub mod wrap;
@@ -53,6 +58,7 @@ pub mod wrap;
 pub use error::{Error, Result};
 pub use mip::{MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
 pub use sample::{Filter, Query, Sampler, SamplerOptions, TexelSink};
+pub use sat::{AccumulatorKind, SatSampler, SummedAreaTable};
 pub use texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 pub use texture::Texture;
 pub use wrap::{Wrap, WrapMode};
