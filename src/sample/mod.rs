@@ -75,6 +75,7 @@ use std::sync::Arc;
 
 use crate::error::{Error, Result};
 use crate::mip::MipChain;
+use crate::sat::SatSampler;
 use crate::wrap::Wrap;
 
 pub use fetch::LinearChain;
@@ -428,9 +429,6 @@ impl SamplerOptions {
                 self.supersample
             ));
         }
-        if self.method == Method::Sat {
-            return Err(sat_unavailable());
-        }
         Ok(())
     }
 
@@ -473,7 +471,7 @@ impl fmt::Display for SamplerOptions {
     }
 }
 
-/// What [`Sampler`] runs (validated options, `Sat` excluded).
+/// What [`Sampler`] runs.
 #[derive(Clone, Copy, Debug)]
 enum Kernel {
     /// `Texel` with `max_aniso == 1`: η = 1, one probe, λ without roots.
@@ -481,6 +479,8 @@ enum Kernel {
     Texel,
     Ewa,
     Supersample,
+    /// Summed-area table over level 0 (`sat`).
+    Sat,
 }
 
 /// A texture ready to be sampled with one set of options.
@@ -496,26 +496,51 @@ pub struct Sampler {
     kernel: Kernel,
     addr: Addressing,
     iso: Iso,
+    sat: Option<Arc<SatSampler>>,
 }
 
 impl Sampler {
     /// Decode `chain` and check `options` (an [`Error::InvalidOption`] for
     /// out-of-range values and for the `sat` filter, which needs a
     /// summed-area table).
+    ///
+    /// For `sat` the summed-area table of level 0 is built here (the
+    /// narrowest exact accumulator, see [`crate::sat::choose`]).
     pub fn new(chain: &MipChain, options: SamplerOptions) -> Result<Self> {
         options.validate()?;
-        Self::from_linear(Arc::new(LinearChain::new(chain)), options)
+        let sat = match options.method {
+            Method::Sat => {
+                let base = chain
+                    .level(0)
+                    .ok_or_else(|| Error::InvalidOption("empty mip chain".into()))?;
+                Some(Arc::new(SatSampler::new(
+                    base,
+                    options.wrap,
+                    options.border,
+                )?))
+            }
+            _ => None,
+        };
+        let mut s = Self::build(Arc::new(LinearChain::new(chain)), options, sat.is_some())?;
+        s.sat = sat;
+        Ok(s)
     }
 
     /// A sampler over an already decoded chain.
+    /// The `sat` filter needs the stored level 0 and is refused here: use
+    /// [`Sampler::new`].
     pub fn from_linear(chain: Arc<LinearChain>, options: SamplerOptions) -> Result<Self> {
+        Self::build(chain, options, false)
+    }
+
+    fn build(chain: Arc<LinearChain>, options: SamplerOptions, have_sat: bool) -> Result<Self> {
         options.validate()?;
         let kernel = match options.method {
             Method::Texel if options.max_aniso == 1 => Kernel::Isotropic,
             Method::Texel => Kernel::Texel,
             Method::Ewa => Kernel::Ewa,
             Method::Supersample => Kernel::Supersample,
-            // `validate` has refused it already; kept as an error, not a panic.
+            Method::Sat if have_sat => Kernel::Sat,
             Method::Sat => return Err(sat_unavailable()),
         };
         Ok(Sampler {
@@ -531,6 +556,7 @@ impl Sampler {
                 min: options.min,
                 mip: options.mip,
             },
+            sat: None,
         })
     }
 
@@ -588,6 +614,12 @@ impl Sampler {
                     sink,
                 )
             }
+            // The table answers from four corner entries per rectangle, not
+            // from texels, so nothing is reported to the sink.
+            Kernel::Sat => match &self.sat {
+                Some(t) => t.sample(q.u, q.v, q.dudx, q.dvdx, q.dudy, q.dvdy),
+                None => [0.0; 4],
+            },
             Kernel::Supersample => {
                 let (dx, dy) = footprint::derivatives(q, levels[0].wf, levels[0].hf);
                 supersample::supersample(
@@ -607,8 +639,8 @@ impl Sampler {
 
 fn sat_unavailable() -> Error {
     Error::InvalidOption(
-        "the sat filter needs a summed-area table, which this sampler does not build yet \
-         (it arrives with the summed-area-table module)"
+        "the sat filter needs the stored level 0 to build its summed-area table: \
+         use Sampler::new"
             .into(),
     )
 }
