@@ -37,6 +37,7 @@
 
 pub mod builtin;
 pub mod error;
+pub mod io;
 pub mod mip;
 pub mod texel;
 pub mod texture;

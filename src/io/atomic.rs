@@ -1,0 +1,146 @@
+//! Atomic writes: an output is either the complete new file or untouched.
+//!
+//! Every writer in [`crate::io`] writes into a [`tempfile::NamedTempFile`]
+//! created in the destination's directory (so the final rename never crosses
+//! a file system), flushes and syncs it, and only then renames it over the
+//! destination. An error, a panic inside a dependency's encoder (the `exr`
+//! crate panics on some invalid inputs, after having written part of the
+//! file) or an interrupt leaves the destination as it was: the temporary
+//! file is deleted when it is dropped (or, after a kill, left behind under a
+//! `.parvo-` name, never under the destination's name).
+//!
+//! Several files that belong together (one PNG per mip level) are first all
+//! [`stage`]d, then all committed, so a failure in level 5 does not leave
+//! levels 0–4 of a new chain next to the old levels 5–12.
+
+use std::any::Any;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+
+use tempfile::NamedTempFile;
+
+use crate::error::{Error, Result};
+
+/// A fully written temporary file waiting to be renamed over `dest`.
+#[derive(Debug)]
+pub struct Staged {
+    tmp: NamedTempFile,
+    dest: PathBuf,
+}
+
+impl Staged {
+    /// Rename the temporary file over the destination.
+    pub fn commit(self) -> Result<()> {
+        let dest = self.dest;
+        self.tmp.persist(&dest).map_err(|e| Error::Io {
+            action: format!("cannot rename into {}", dest.display()),
+            path: dest.clone(),
+            source: e.error,
+        })?;
+        Ok(())
+    }
+
+    /// The destination this file will be renamed to.
+    pub fn dest(&self) -> &Path {
+        &self.dest
+    }
+}
+
+/// Write `dest` atomically with `write` (see the module docs).
+pub fn write<F>(dest: &Path, write: F) -> Result<()>
+where
+    F: FnOnce(&mut BufWriter<&File>) -> Result<()>,
+{
+    stage(dest, write)?.commit()
+}
+
+/// Write the contents of `dest` into a temporary file beside it, without
+/// renaming it yet. Dropping the result deletes the temporary file.
+pub fn stage<F>(dest: &Path, write: F) -> Result<Staged>
+where
+    F: FnOnce(&mut BufWriter<&File>) -> Result<()>,
+{
+    if dest.is_dir() {
+        return Err(Error::Io {
+            path: dest.to_path_buf(),
+            action: format!("cannot write {}", dest.display()),
+            source: std::io::Error::other("it is a directory"),
+        });
+    }
+    let dir = match dest.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let tmp = tempfile::Builder::new()
+        .prefix(".parvo-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| Error::Io {
+            path: dir.to_path_buf(),
+            action: format!("cannot create a file in {}", dir.display()),
+            source: e,
+        })?;
+    let io_err = |e: std::io::Error| Error::Io {
+        path: dest.to_path_buf(),
+        action: format!("cannot write {}", dest.display()),
+        source: e,
+    };
+    {
+        let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
+        match catch_unwind(AssertUnwindSafe(|| write(&mut w))) {
+            Ok(r) => r?,
+            Err(payload) => {
+                return Err(Error::Encode {
+                    format: "output",
+                    reason: format!("encoder panicked: {}", panic_message(&*payload)),
+                });
+            }
+        }
+        w.flush().map_err(io_err)?;
+    }
+    tmp.as_file().sync_all().map_err(io_err)?;
+    Ok(Staged {
+        tmp,
+        dest: dest.to_path_buf(),
+    })
+}
+
+/// Text of a panic payload (`&str` or `String`), or a placeholder.
+pub fn panic_message(payload: &(dyn Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failed_and_panicking_writers_leave_the_destination_untouched() {
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("out.bin");
+        std::fs::write(&dest, b"old").unwrap();
+        let e = write(&dest, |w| {
+            w.write_all(b"partial").unwrap();
+            Err(Error::InvalidOption("boom".into()))
+        });
+        assert!(e.is_err());
+        let e = write(&dest, |w| {
+            w.write_all(b"partial").unwrap();
+            panic!("dependency bug")
+        });
+        assert!(e.unwrap_err().to_string().contains("dependency bug"));
+        assert_eq!(std::fs::read(&dest).unwrap(), b"old");
+        // Only the destination is left: no temporary files.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        write(&dest, |w| Ok(w.write_all(b"new").unwrap())).unwrap();
+        assert_eq!(std::fs::read(&dest).unwrap(), b"new");
+    }
+}

@@ -1,0 +1,451 @@
+//! OpenEXR: read scanline, tiled and mip-mapped files (all levels, also
+//! files maketx writes) and write tiled, mip-mapped textures.
+//!
+//! Reading goes through the `exr` crate after the header has been checked
+//! against [`Limits`] (the declared size of every level the file holds).
+//! Channels: `R,G,B[,A]` (also with a layer prefix such as `diffuse.R`),
+//! `Y[,A]` (grey), or any one channel. Half files load as f16, everything
+//! else (float, uint) as f32. EXR data is linear light.
+//!
+//! Writing: the `exr` crate panics when the number of levels does not match
+//! the chain its header implies and when mip maps are asked for without
+//! tiles, so [`save`] checks both first, and writes through
+//! [`atomic`](super::atomic) so that even a panic never reaches the
+//! destination. Channel names follow the convention texture systems read:
+//! `R,G,B,A`, grey `Y`, grey + alpha `Y,A`. Besides the pixels the header
+//! gets what OpenImageIO's texture system reads (`wrapmodes` as maketx
+//! writes it, e.g. `periodic,periodic`; `textureformat` = `Plain Texture`),
+//! the rounding mode in the tile description, and parvo's own attributes
+//! (`parvo:...`, including the fingerprint that `--update` compares).
+
+use std::fmt;
+use std::path::Path;
+use std::str::FromStr;
+
+use ::exr::math::RoundingMode;
+use ::exr::meta::attribute::{AttributeValue, LevelMode, SampleType, Text};
+use ::exr::meta::{BlockDescription, MetaData};
+use ::exr::prelude::traits::{ReadChannels, ReadLayers, WritableImage};
+use ::exr::prelude::{
+    AnyChannel, AnyChannels, Blocks, Encoding, FlatSamples, Image, Layer, LayerAttributes,
+    LineOrder, SmallVec, Vec2,
+};
+use half::f16;
+
+use super::{FINGERPRINT_KEY, FileFormat, Limits, Loaded, SaveOptions, SourceInfo, atomic};
+use crate::error::{Error, Result};
+use crate::mip::Rounding;
+use crate::texel::{ChannelType, ColorSpace, Format, Texels};
+use crate::texture::Texture;
+
+/// EXR compression, by the names OpenEXR tools use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum ExrCompression {
+    /// `none`.
+    None,
+    /// `rle`.
+    Rle,
+    /// `zips`: zlib, one scanline per block.
+    Zips,
+    /// `zip`: zlib, 16 scanlines per block (the default, as maketx).
+    #[default]
+    Zip,
+    /// `piz`: wavelet + Huffman.
+    Piz,
+    /// `pxr24`: lossy for f32 (24-bit), lossless for f16.
+    Pxr24,
+    /// `b44`: lossy, f16 only.
+    B44,
+    /// `b44a`: `b44` with flat-area optimisation.
+    B44a,
+    /// `dwaa`: lossy DCT, 32 scanlines.
+    Dwaa,
+    /// `dwab`: lossy DCT, 256 scanlines.
+    Dwab,
+}
+
+impl ExrCompression {
+    /// Every compression, in a stable order.
+    pub const ALL: [ExrCompression; 10] = [
+        ExrCompression::None,
+        ExrCompression::Rle,
+        ExrCompression::Zips,
+        ExrCompression::Zip,
+        ExrCompression::Piz,
+        ExrCompression::Pxr24,
+        ExrCompression::B44,
+        ExrCompression::B44a,
+        ExrCompression::Dwaa,
+        ExrCompression::Dwab,
+    ];
+
+    /// The OpenEXR name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ExrCompression::None => "none",
+            ExrCompression::Rle => "rle",
+            ExrCompression::Zips => "zips",
+            ExrCompression::Zip => "zip",
+            ExrCompression::Piz => "piz",
+            ExrCompression::Pxr24 => "pxr24",
+            ExrCompression::B44 => "b44",
+            ExrCompression::B44a => "b44a",
+            ExrCompression::Dwaa => "dwaa",
+            ExrCompression::Dwab => "dwab",
+        }
+    }
+
+    fn to_exr(self) -> ::exr::compression::Compression {
+        use ::exr::compression::Compression as C;
+        match self {
+            ExrCompression::None => C::Uncompressed,
+            ExrCompression::Rle => C::RLE,
+            ExrCompression::Zips => C::ZIP1,
+            ExrCompression::Zip => C::ZIP16,
+            ExrCompression::Piz => C::PIZ,
+            ExrCompression::Pxr24 => C::PXR24,
+            ExrCompression::B44 => C::B44,
+            ExrCompression::B44a => C::B44A,
+            ExrCompression::Dwaa => C::DWAA(None),
+            ExrCompression::Dwab => C::DWAB(None),
+        }
+    }
+}
+
+impl fmt::Display for ExrCompression {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ExrCompression {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        ExrCompression::ALL
+            .into_iter()
+            .find(|c| c.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| {
+                Error::parse(
+                    "EXR compression",
+                    s,
+                    "expected none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa or dwab",
+                )
+            })
+    }
+}
+
+fn decode_err(e: impl fmt::Display) -> Error {
+    Error::Decode {
+        format: "OpenEXR",
+        reason: e.to_string(),
+    }
+}
+
+fn encode_err(e: impl fmt::Display) -> Error {
+    Error::Encode {
+        format: "OpenEXR",
+        reason: e.to_string(),
+    }
+}
+
+fn to_exr_rounding(r: Rounding) -> RoundingMode {
+    match r {
+        Rounding::Down => RoundingMode::Down,
+        Rounding::Up => RoundingMode::Up,
+    }
+}
+
+/// Level sizes the header of a tiled mip-mapped file of this size implies.
+fn exr_level_sizes(w: u32, h: u32, r: Rounding) -> Vec<(u32, u32)> {
+    ::exr::meta::mip_map_levels(to_exr_rounding(r), Vec2(w as usize, h as usize))
+        .map(|(_, s)| (s.width() as u32, s.height() as u32))
+        .collect()
+}
+
+/// Write `levels` as a tiled, mip-mapped EXR (see the module docs).
+pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOptions) -> Result<()> {
+    let first = &levels[0];
+    let (w, h) = (first.width(), first.height());
+    let want = exr_level_sizes(w, h, rounding);
+    let have: Vec<_> = levels.iter().map(|l| (l.width(), l.height())).collect();
+    if levels.len() > 1 && have != want {
+        return Err(encode_err(format!(
+            "a mip-mapped OpenEXR file holds the full chain of {} levels, got {} (do not limit --levels for .exr)",
+            want.len(),
+            levels.len()
+        )));
+    }
+    let (tw, th) = opts.tile;
+    if tw == 0 || th == 0 {
+        return Err(encode_err("tile size must be at least 1x1"));
+    }
+    let fmt = first.format();
+    if !fmt.channel_type.is_float() {
+        return Err(encode_err(format!(
+            "EXR stores f16 or f32, not {}",
+            fmt.channel_type
+        )));
+    }
+    if fmt.color_space == ColorSpace::Srgb {
+        return Err(encode_err(
+            "EXR holds linear data; convert sRGB texels first",
+        ));
+    }
+    let ch = first.channels();
+    let names = super::layout_names(fmt.channels);
+    let rounding_mode = to_exr_rounding(rounding);
+    let mut list: SmallVec<[AnyChannel<::exr::image::Levels<FlatSamples>>; 4]> = SmallVec::new();
+    for (c, name) in names.iter().enumerate() {
+        let planes: Vec<FlatSamples> = levels
+            .iter()
+            .map(|l| match l.texels() {
+                Texels::F16(v) => FlatSamples::F16(v.iter().skip(c).step_by(ch).copied().collect()),
+                Texels::F32(v) => FlatSamples::F32(v.iter().skip(c).step_by(ch).copied().collect()),
+                _ => unreachable!("checked above: float texels"),
+            })
+            .collect();
+        let data = if levels.len() == 1 {
+            ::exr::image::Levels::Singular(planes.into_iter().next().expect("one level"))
+        } else {
+            ::exr::image::Levels::Mip {
+                rounding_mode,
+                level_data: planes,
+            }
+        };
+        list.push(AnyChannel::new(name.as_str(), data));
+    }
+    let mut attrs = LayerAttributes {
+        software_name: Some(Text::from(concat!("parvo ", env!("CARGO_PKG_VERSION")))),
+        ..LayerAttributes::default()
+    };
+    let mut put = |k: &str, v: &str| -> Result<()> {
+        let key =
+            Text::new_or_none(k).ok_or_else(|| encode_err(format!("bad attribute name `{k}`")))?;
+        let val = Text::new_or_none(v)
+            .ok_or_else(|| encode_err(format!("attribute `{k}` is not representable: `{v}`")))?;
+        attrs.other.insert(key, AttributeValue::Text(val));
+        Ok(())
+    };
+    put(
+        "wrapmodes",
+        &format!("{},{}", opts.wrap.u.oiio_name(), opts.wrap.v.oiio_name()),
+    )?;
+    put("textureformat", "Plain Texture")?;
+    if let Some(fp) = &opts.fingerprint {
+        put(FINGERPRINT_KEY, fp)?;
+    }
+    for (k, v) in &opts.attributes {
+        put(k, v)?;
+    }
+    let encoding = Encoding {
+        compression: opts.compression.to_exr(),
+        blocks: Blocks::Tiles(Vec2(tw as usize, th as usize)),
+        line_order: LineOrder::Increasing,
+    };
+    let layer = Layer::new(
+        Vec2(w as usize, h as usize),
+        attrs,
+        encoding,
+        AnyChannels::sort(list),
+    );
+    let image = Image::from_layer(layer);
+    atomic::write(path, |out| {
+        image.write().to_buffered(out).map_err(encode_err)
+    })
+}
+
+/// Read the fingerprint attribute of an EXR file written by parvo.
+pub fn stored_fingerprint(path: &Path) -> Option<String> {
+    let meta = MetaData::read_from_file(path, false).ok()?;
+    let header = meta.headers.first()?;
+    let key = Text::from(FINGERPRINT_KEY);
+    let v = header
+        .own_attributes
+        .other
+        .get(&key)
+        .or_else(|| header.shared_attributes.other.get(&key))?;
+    match v {
+        AttributeValue::Text(t) => Some(t.to_string()),
+        _ => None,
+    }
+}
+
+fn attribute_text(v: &AttributeValue) -> String {
+    match v {
+        AttributeValue::Text(t) => t.to_string(),
+        AttributeValue::F32(x) => x.to_string(),
+        AttributeValue::F64(x) => x.to_string(),
+        AttributeValue::I32(x) => x.to_string(),
+        AttributeValue::TextVector(v) => v
+            .iter()
+            .map(|t| t.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        other => format!("{other:?}"),
+    }
+}
+
+/// Load an EXR file: the first part, all its mip levels.
+pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
+    let meta = MetaData::read_from_file(path, false).map_err(decode_err)?;
+    let header = meta
+        .headers
+        .first()
+        .ok_or_else(|| decode_err("no image part in the file"))?;
+    if header.deep {
+        return Err(decode_err("deep data is not a texture"));
+    }
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    let (sizes, tile, rounding, mipmapped) = match header.blocks {
+        BlockDescription::ScanLines => (vec![(w, h)], None, Rounding::Down, false),
+        BlockDescription::Tiles(t) => {
+            let rounding = match t.rounding_mode {
+                RoundingMode::Down => Rounding::Down,
+                RoundingMode::Up => Rounding::Up,
+            };
+            let tile = Some((t.tile_size.width() as u32, t.tile_size.height() as u32));
+            match t.level_mode {
+                LevelMode::MipMap => {
+                    let s: Vec<_> = ::exr::meta::mip_map_levels(t.rounding_mode, header.layer_size)
+                        .map(|(_, s)| (s.width(), s.height()))
+                        .collect();
+                    (s, tile, rounding, true)
+                }
+                // Rip maps: only level 0 (anisotropic levels are not a mip chain).
+                _ => (vec![(w, h)], tile, rounding, false),
+            }
+        }
+    };
+    let channels = header.channels.list.len() as u64;
+    let texels: u64 = sizes.iter().map(|&(a, b)| a as u64 * b as u64).sum();
+    // Decoded bytes: the exr crate's planes plus our interleaved copy.
+    limits.check(
+        w as u64,
+        h as u64,
+        texels.saturating_mul(channels).saturating_mul(8),
+    )?;
+    let mut attributes: Vec<(String, String)> = Vec::new();
+    for (k, v) in header
+        .shared_attributes
+        .other
+        .iter()
+        .chain(header.own_attributes.other.iter())
+    {
+        attributes.push((k.to_string(), attribute_text(v)));
+    }
+    let own = &header.own_attributes;
+    for (k, v) in [
+        ("software", &own.software_name),
+        ("comments", &own.comments),
+        ("owner", &own.owner),
+        ("capDate", &own.capture_date),
+        ("name", &own.layer_name),
+    ] {
+        if let Some(t) = v {
+            attributes.push((k.to_string(), t.to_string()));
+        }
+    }
+    attributes.push(("compression".into(), header.compression.to_string()));
+    attributes.sort();
+    let wrap = attributes
+        .iter()
+        .find(|(k, _)| k == "wrapmodes")
+        .and_then(|(_, v)| v.parse().ok());
+
+    let image = ::exr::prelude::read()
+        .no_deep_data()
+        .all_resolution_levels()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(decode_err)?;
+    let layer = image.layer_data;
+    let list = &layer.channel_data.list;
+    let all_names: Vec<String> = list.iter().map(|c| c.name.to_string()).collect();
+    let short = |n: &str| n.rsplit('.').next().unwrap_or(n).to_string();
+    let find = |want: &str| all_names.iter().position(|n| short(n) == want);
+    let order: Vec<usize> = match (find("R"), find("G"), find("B"), find("A"), find("Y")) {
+        (Some(r), Some(g), Some(b), a, _) => [Some(r), Some(g), Some(b), a]
+            .into_iter()
+            .flatten()
+            .collect(),
+        (_, _, _, a, Some(y)) => [Some(y), a].into_iter().flatten().collect(),
+        _ if (1..=4).contains(&list.len()) => (0..list.len()).collect(),
+        _ => {
+            return Err(decode_err(format!(
+                "channels {} do not form a texture (expected R,G,B[,A], Y[,A] or 1 to 4 channels)",
+                all_names.join(",")
+            )));
+        }
+    };
+    let half = order
+        .iter()
+        .all(|&i| header.channels.list[i].sample_type == SampleType::F16);
+    let per_channel: Vec<Vec<&FlatSamples>> = order
+        .iter()
+        .map(|&i| match &list[i].sample_data {
+            ::exr::image::Levels::Singular(s) => vec![s],
+            ::exr::image::Levels::Mip { level_data, .. } => level_data.iter().collect(),
+            ::exr::image::Levels::Rip { level_data, .. } => {
+                level_data.map_data.iter().take(1).collect()
+            }
+        })
+        .collect();
+    let nlev = per_channel[0].len();
+    if nlev == 0
+        || per_channel.iter().any(|c| c.len() != nlev)
+        || (mipmapped && nlev != sizes.len())
+    {
+        return Err(decode_err("inconsistent mip levels between channels"));
+    }
+    let ch = order.len();
+    let ty = if half {
+        ChannelType::F16
+    } else {
+        ChannelType::F32
+    };
+    let format = Format::new(ch as u8, ty, ColorSpace::Linear);
+    let mut levels = Vec::with_capacity(nlev);
+    for (k, &(lw, lh)) in sizes.iter().enumerate().take(nlev) {
+        let n = lw * lh;
+        let texels = if half {
+            let mut out = vec![f16::ZERO; n * ch];
+            for (c, planes) in per_channel.iter().enumerate() {
+                let FlatSamples::F16(p) = planes[k] else {
+                    return Err(decode_err("channel type changed between levels"));
+                };
+                if p.len() != n {
+                    return Err(decode_err("level has the wrong number of samples"));
+                }
+                for (o, v) in out.iter_mut().skip(c).step_by(ch).zip(p.iter()) {
+                    *o = *v;
+                }
+            }
+            Texels::F16(out)
+        } else {
+            let mut out = vec![0f32; n * ch];
+            for (c, planes) in per_channel.iter().enumerate() {
+                let p = planes[k];
+                if p.len() != n {
+                    return Err(decode_err("level has the wrong number of samples"));
+                }
+                for (o, v) in out.iter_mut().skip(c).step_by(ch).zip(p.values_as_f32()) {
+                    *o = v;
+                }
+            }
+            Texels::F32(out)
+        };
+        levels.push(Texture::from_texels(lw as u32, lh as u32, format, texels)?);
+    }
+    let info = SourceInfo {
+        format: FileFormat::Exr,
+        own_mips: levels.len() > 1,
+        rounding,
+        wrap,
+        tile,
+        channel_names: order.iter().map(|&i| all_names[i].clone()).collect(),
+        attributes,
+    };
+    Ok(Loaded { levels, info })
+}
