@@ -216,6 +216,13 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
     }
     let mut attrs = LayerAttributes {
         software_name: Some(Text::from(concat!("parvo ", env!("CARGO_PKG_VERSION")))),
+        // `wrapmodes`, as maketx writes it (the exr crate reserves the name
+        // for this field).
+        wrap_mode_name: Text::new_or_none(format!(
+            "{},{}",
+            opts.wrap.u.oiio_name(),
+            opts.wrap.v.oiio_name()
+        )),
         ..LayerAttributes::default()
     };
     let mut put = |k: &str, v: &str| -> Result<()> {
@@ -226,10 +233,6 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
         attrs.other.insert(key, AttributeValue::Text(val));
         Ok(())
     };
-    put(
-        "wrapmodes",
-        &format!("{},{}", opts.wrap.u.oiio_name(), opts.wrap.v.oiio_name()),
-    )?;
     put("textureformat", "Plain Texture")?;
     if let Some(fp) = &opts.fingerprint {
         put(FINGERPRINT_KEY, fp)?;
@@ -340,6 +343,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         ("owner", &own.owner),
         ("capDate", &own.capture_date),
         ("name", &own.layer_name),
+        ("wrapmodes", &own.wrap_mode_name),
     ] {
         if let Some(t) = v {
             attributes.push((k.to_string(), t.to_string()));
