@@ -67,14 +67,15 @@ pub enum Error {
     #[error("invalid option: {0}")]
     InvalidOption(String),
     /// A file or directory could not be opened, read or written.
-    #[error("{action}: {source}")]
+    #[error("{action}: {error}")]
     Io {
         /// The file or directory involved.
         path: std::path::PathBuf,
         /// What was being done ("cannot open", "cannot rename into place", ...).
         action: String,
-        /// The operating system's error.
-        source: std::io::Error,
+        /// The operating system's error (part of the message, so not
+        /// also reported as the error's `source`).
+        error: std::io::Error,
     },
     /// A file's contents could not be decoded: corrupt, truncated, or a
     /// variant of the format parvo does not support.

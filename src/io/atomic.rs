@@ -37,7 +37,7 @@ impl Staged {
         self.tmp.persist(&dest).map_err(|e| Error::Io {
             action: format!("cannot rename into {}", dest.display()),
             path: dest.clone(),
-            source: e.error,
+            error: e.error,
         })?;
         Ok(())
     }
@@ -66,7 +66,7 @@ where
         return Err(Error::Io {
             path: dest.to_path_buf(),
             action: format!("cannot write {}", dest.display()),
-            source: std::io::Error::other("it is a directory"),
+            error: std::io::Error::other("it is a directory"),
         });
     }
     let dir = match dest.parent() {
@@ -80,12 +80,18 @@ where
         .map_err(|e| Error::Io {
             path: dir.to_path_buf(),
             action: format!("cannot create a file in {}", dir.display()),
-            source: e,
+            // tempfile appends the random temporary name; keep only the
+            // operating system's reason.
+            error: {
+                let msg = e.to_string();
+                let reason = msg.split(" at path ").next().unwrap_or(&msg).to_string();
+                std::io::Error::new(e.kind(), reason)
+            },
         })?;
     let io_err = |e: std::io::Error| Error::Io {
         path: dest.to_path_buf(),
         action: format!("cannot write {}", dest.display()),
-        source: e,
+        error: e,
     };
     {
         let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());

@@ -130,7 +130,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     let file = std::fs::File::open(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         action: "cannot open".into(),
-        source: e,
+        error: e,
     })?;
     let (w, h) = {
         // Check the declared size before ddsfile allocates the data.
@@ -145,7 +145,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     let file = std::fs::File::open(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         action: "cannot open".into(),
-        source: e,
+        error: e,
     })?;
     let dds = Dds::read(std::io::BufReader::new(file)).map_err(decode_err)?;
     let dxgi = dds

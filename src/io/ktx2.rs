@@ -264,7 +264,7 @@ fn read_bytes(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
         .map_err(|e| Error::Io {
             path: path.to_path_buf(),
             action: "cannot open".into(),
-            source: e,
+            error: e,
         })?
         .len();
     if len > limits.max_alloc {
@@ -277,7 +277,7 @@ fn read_bytes(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
     std::fs::read(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         action: "cannot read".into(),
-        source: e,
+        error: e,
     })
 }
 

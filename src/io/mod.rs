@@ -170,13 +170,13 @@ pub fn load(spec: &str, limits: &Limits) -> Result<Loaded> {
     let meta = std::fs::metadata(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         action: "cannot open".into(),
-        source: e,
+        error: e,
     })?;
     if meta.is_dir() {
         return Err(Error::Io {
             path: path.to_path_buf(),
             action: "cannot read".into(),
-            source: std::io::Error::other("it is a directory, not a texture file"),
+            error: std::io::Error::other("it is a directory, not a texture file"),
         });
     }
     if meta.len() == 0 {
@@ -200,7 +200,7 @@ pub fn load(spec: &str, limits: &Limits) -> Result<Loaded> {
         .map_err(|e| Error::Io {
             path: path.to_path_buf(),
             action: "cannot read".into(),
-            source: e,
+            error: e,
         })?;
     let magic = &magic[..n];
     if magic.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
@@ -241,7 +241,7 @@ fn load_image(path: &Path, limits: &Limits) -> Result<Loaded> {
         .map_err(|e| Error::Io {
             path: path.to_path_buf(),
             action: "cannot open".into(),
-            source: e,
+            error: e,
         })?
         .with_guessed_format()
         .map_err(|e| decode(e.to_string()))?;
