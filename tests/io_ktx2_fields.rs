@@ -89,7 +89,7 @@ fn ktx2_header_level_index_and_dfd_match_the_specification() {
         // level aligned to lcm(texel size, 4), lengths exact.
         let texel = format.texel_bytes() as u64;
         let align = (1..=texel * 4)
-            .find(|m| m % texel == 0 && m % 4 == 0)
+            .find(|m| m.is_multiple_of(texel) && m.is_multiple_of(4))
             .unwrap();
         let mut prev_offset = u64::MAX;
         for (k, lvl) in levels.iter().enumerate() {

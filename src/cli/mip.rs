@@ -271,10 +271,10 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     if args.levels == Some(0) {
         return usage("--levels must be at least 1".into());
     }
-    if let Some(r) = args.alpha_coverage {
-        if !(r > 0.0 && r < 1.0) {
-            return usage(format!("--alpha-coverage {r}: must be between 0 and 1"));
-        }
+    if let Some(r) = args.alpha_coverage
+        && !(r > 0.0 && r < 1.0)
+    {
+        return usage(format!("--alpha-coverage {r}: must be between 0 and 1"));
     }
     let jobs = match (&args.output, &args.out_dir) {
         (Some(out), None) => {
@@ -395,10 +395,8 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
                 }
             }
         }
-        if batch {
-            if let Some(b) = &bar {
-                b.inc(1);
-            }
+        if batch && let Some(b) = &bar {
+            b.inc(1);
         }
     };
     if batch {

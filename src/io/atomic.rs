@@ -146,7 +146,11 @@ mod tests {
         assert_eq!(std::fs::read(&dest).unwrap(), b"old");
         // Only the destination is left: no temporary files.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
-        write(&dest, |w| Ok(w.write_all(b"new").unwrap())).unwrap();
+        write(&dest, |w| {
+            w.write_all(b"new").unwrap();
+            Ok(())
+        })
+        .unwrap();
         assert_eq!(std::fs::read(&dest).unwrap(), b"new");
     }
 }

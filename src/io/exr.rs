@@ -10,7 +10,7 @@
 //! Writing: the `exr` crate panics when the number of levels does not match
 //! the chain its header implies and when mip maps are asked for without
 //! tiles, so [`save`] checks both first, and writes through
-//! [`atomic`](super::atomic) so that even a panic never reaches the
+//! [`atomic`] so that even a panic never reaches the
 //! destination. Channel names follow the convention texture systems read:
 //! `R,G,B,A`, grey `Y`, grey + alpha `Y,A`. Besides the pixels the header
 //! gets what OpenImageIO's texture system reads (`wrapmodes` as maketx

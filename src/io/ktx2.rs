@@ -151,7 +151,7 @@ fn kv_entry(key: &str, value: &str) -> Vec<u8> {
     kv.push(0);
     let mut out = (kv.len() as u32).to_le_bytes().to_vec();
     out.extend_from_slice(&kv);
-    while out.len() % 4 != 0 {
+    while !out.len().is_multiple_of(4) {
         out.push(0);
     }
     out

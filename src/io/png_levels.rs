@@ -1,7 +1,7 @@
 //! One PNG per mip level: an output name containing `{level}` (e.g.
 //! `out_{level}.png`) becomes `out_0.png`, `out_1.png`, ... 8- or 16-bit,
 //! 1–4 channels as stored. All files are staged first and renamed only when
-//! every level has been encoded (see [`atomic`](super::atomic)).
+//! every level has been encoded (see [`atomic`]).
 
 use std::path::{Path, PathBuf};
 
