@@ -43,6 +43,17 @@ pub enum ColorArg {
     Srgb,
 }
 
+/// Alpha convention of the input.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum AlphaArg {
+    /// Premultiplied for OpenEXR, straight otherwise.
+    Auto,
+    /// Colour is independent of alpha (unassociated).
+    Straight,
+    /// Colour is already multiplied by alpha (associated).
+    Premultiplied,
+}
+
 /// Output container for `--out-dir` batches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ExtArg {
@@ -92,9 +103,17 @@ pub struct MipArgs {
     #[arg(long, value_enum, default_value = "auto")]
     color: ColorArg,
 
-    /// Alpha convention of the input: straight or premultiplied.
-    #[arg(long, default_value = "straight", value_name = "MODE")]
-    alpha: AlphaMode,
+    /// Alpha convention of the input: auto, straight or premultiplied.
+    #[arg(
+        long,
+        value_enum,
+        default_value = "auto",
+        value_name = "MODE",
+        long_help = "Alpha convention of the input. auto: premultiplied (associated) for OpenEXR, \
+        as the format defines it, straight for everything else. Straight alpha is filtered with \
+        alpha weighting; EXR outputs are always written premultiplied, as OpenEXR readers expect."
+    )]
+    alpha: AlphaArg,
 
     /// Preserve alpha-test coverage at this reference alpha (0 < REF < 1).
     #[arg(long, value_name = "REF")]
@@ -465,7 +484,13 @@ fn output_format(src: Format, kind: OutputKind, args: &MipArgs) -> anyhow::Resul
     } else {
         src.color_space
     };
-    let f = Format::new(src.channels, ty, cs).with_alpha(src.alpha);
+    let alpha = if kind == OutputKind::Exr && src.has_alpha() {
+        // OpenEXR defines colour as associated with alpha.
+        AlphaMode::Premultiplied
+    } else {
+        src.alpha
+    };
+    let f = Format::new(src.channels, ty, cs).with_alpha(alpha);
     Ok(match kind {
         OutputKind::Ktx2 => io::ktx2::storable(f),
         OutputKind::Dds => io::dds::storable(f),
@@ -510,7 +535,11 @@ fn process(
         (ColorArg::Srgb, _) => ColorSpace::Srgb,
         (ColorArg::Auto, false) => auto_color(src_kind, src),
     };
-    src.alpha = args.alpha;
+    src.alpha = match args.alpha {
+        AlphaArg::Auto => src.alpha,
+        AlphaArg::Straight => AlphaMode::Straight,
+        AlphaArg::Premultiplied => AlphaMode::Premultiplied,
+    };
     base = base.reinterpret(src)?;
     let read_s = t_read.elapsed().as_secs_f64();
 
@@ -571,8 +600,12 @@ fn process(
     // Build in the source format when it is the output format, else in
     // linear f32 (see the module docs).
     let t_build = Instant::now();
-    let same =
-        src.channel_type == out_format.channel_type && src.color_space == out_format.color_space;
+    let premultiply = out_format.has_alpha()
+        && src.alpha == AlphaMode::Straight
+        && out_format.alpha == AlphaMode::Premultiplied;
+    let same = src.channel_type == out_format.channel_type
+        && src.color_space == out_format.color_space
+        && !premultiply;
     let work_base = if same {
         base
     } else {
@@ -598,7 +631,7 @@ fn process(
     let levels: Vec<Texture> = chain
         .into_levels()
         .into_iter()
-        .map(|l| convert_level(l, out_format))
+        .map(|l| convert_level(l, out_format, premultiply))
         .collect::<anyhow::Result<_>>()?;
     let build_s = t_build.elapsed().as_secs_f64();
 
@@ -645,15 +678,32 @@ fn auto_color(kind: FileFormat, f: Format) -> ColorSpace {
 
 /// Convert a built level to the output format (type, colour space, and
 /// channel widening for containers that need it).
-fn convert_level(l: Texture, out: Format) -> anyhow::Result<Texture> {
+fn convert_level(mut l: Texture, out: Format, premultiply: bool) -> anyhow::Result<Texture> {
+    if premultiply {
+        // Built in linear f32 (see `process`): associate colour with alpha.
+        let ch = l.channels();
+        let Texels::F32(v) = l.texels_mut() else {
+            anyhow::bail!("premultiplying needs f32 levels");
+        };
+        v.par_chunks_mut(ch * 4096).for_each(|rows| {
+            for px in rows.chunks_exact_mut(ch) {
+                let a = px[ch - 1];
+                for c in &mut px[..ch - 1] {
+                    *c *= a;
+                }
+            }
+        });
+        let f = l.format().with_alpha(AlphaMode::Premultiplied);
+        l = l.reinterpret(f)?;
+    }
     let narrow = Format {
         channels: l.format().channels,
         ..out
     };
     let conv = if l.format() == narrow {
         l
-    } else if l.format()
-        == Format::new(narrow.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(out.alpha)
+    } else if l.channel_type() == ChannelType::F32
+        && l.format().color_space == ColorSpace::Linear
         && narrow.channel_type == ChannelType::F16
         && narrow.color_space == ColorSpace::Linear
     {

@@ -5,7 +5,10 @@
 //! against [`Limits`] (the declared size of every level the file holds).
 //! Channels: `R,G,B[,A]` (also with a layer prefix such as `diffuse.R`),
 //! `Y[,A]` (grey), or any one channel. Half files load as f16, everything
-//! else (float, uint) as f32. EXR data is linear light.
+//! else (float, uint) as f32. EXR data is linear light with premultiplied
+//! (associated) alpha, as the OpenEXR documentation defines it; [`save`]
+//! expects premultiplied levels too (the CLI premultiplies straight
+//! sources before writing).
 //!
 //! Writing: the `exr` crate panics when the number of levels does not match
 //! the chain its header implies and when mip maps are asked for without
@@ -35,7 +38,7 @@ use half::f16;
 use super::{FINGERPRINT_KEY, FileFormat, Limits, Loaded, SaveOptions, SourceInfo, atomic};
 use crate::error::{Error, Result};
 use crate::mip::Rounding;
-use crate::texel::{ChannelType, ColorSpace, Format, Texels};
+use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
 /// EXR compression, by the names OpenEXR tools use.
@@ -409,7 +412,11 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     } else {
         ChannelType::F32
     };
-    let format = Format::new(ch as u8, ty, ColorSpace::Linear);
+    // OpenEXR stores colour associated with (premultiplied by) alpha.
+    let mut format = Format::new(ch as u8, ty, ColorSpace::Linear);
+    if format.has_alpha() {
+        format = format.with_alpha(AlphaMode::Premultiplied);
+    }
     let mut levels = Vec::with_capacity(nlev);
     for (k, &(lw, lh)) in sizes.iter().enumerate().take(nlev) {
         let n = lw * lh;
