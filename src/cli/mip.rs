@@ -609,11 +609,15 @@ fn process(
     let work_base = if same {
         base
     } else {
+        // Decode straight into the f32 buffer (`Texture::convert` would
+        // hold a second full-size f32 copy while encoding).
         let f =
             Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
-        let b = base.convert(f)?;
+        let mut linear = vec![0f32; base.texels().len()];
+        parvo::texel::decode_to_linear(&base.format(), base.texels(), &mut linear);
+        let (w, h) = (base.width(), base.height());
         drop(base);
-        b
+        Texture::from_f32(w, h, f, linear)?
     };
     if let Some(b) = bar {
         let total: u64 = level_sizes[1..]
@@ -628,11 +632,15 @@ fn process(
             b.set_position(p.texels_done);
         }
     })?;
-    let levels: Vec<Texture> = chain
+    // Smallest level first, so level 0's f32 and converted copies never
+    // coexist with the unconverted rest of the chain.
+    let mut levels: Vec<Texture> = chain
         .into_levels()
         .into_iter()
+        .rev()
         .map(|l| convert_level(l, out_format, premultiply))
         .collect::<anyhow::Result<_>>()?;
+    levels.reverse();
     let build_s = t_build.elapsed().as_secs_f64();
 
     let t_write = Instant::now();
