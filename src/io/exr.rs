@@ -356,14 +356,21 @@ fn zip_compress(raw: Vec<u8>) -> ::exr::error::Result<Vec<u8>> {
     let n = raw.len();
     let half = n.div_ceil(2);
     let mut tmp = vec![0u8; n];
-    for (i, &b) in raw.iter().enumerate() {
-        tmp[if i % 2 == 0 { i / 2 } else { half + i / 2 }] = b;
+    {
+        let (even, odd) = tmp.split_at_mut(half);
+        let pairs = raw.chunks_exact(2);
+        if let [last] = pairs.remainder() {
+            even[half - 1] = *last;
+        }
+        for ((p, e), o) in pairs.zip(even.iter_mut()).zip(odd.iter_mut()) {
+            *e = p[0];
+            *o = p[1];
+        }
     }
-    let mut prev = tmp.first().copied().unwrap_or(0);
-    for t in tmp.iter_mut().skip(1) {
-        let cur = *t;
-        *t = (cur as i32 - prev as i32 + 128 + 256) as u8;
-        prev = cur;
+    // Delta predictor, back to front so each byte still sees its
+    // unmodified predecessor: t[i] = t[i] - t[i-1] + 128 (mod 256).
+    for i in (1..n).rev() {
+        tmp[i] = tmp[i].wrapping_sub(tmp[i - 1]).wrapping_add(128);
     }
     let out = DEFLATE.with(|c| {
         let mut c = c.borrow_mut();
