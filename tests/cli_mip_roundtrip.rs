@@ -309,3 +309,60 @@ fn grey_and_rgb_sources_keep_their_channels_where_the_container_can() {
             .all(|l| l.to_linear().chunks(4).all(|p| p[3] == 1.0))
     );
 }
+
+#[test]
+fn batch_names_outputs_after_inputs_and_refuses_duplicate_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.png");
+    let a_jpg = dir.path().join("a.jpg");
+    image::save_buffer(
+        &a,
+        &noise(8 * 8 * 3, 1),
+        8,
+        8,
+        image::ExtendedColorType::Rgb8,
+    )
+    .unwrap();
+    image::save_buffer(
+        &a_jpg,
+        &noise(8 * 8 * 3, 2),
+        8,
+        8,
+        image::ExtendedColorType::Rgb8,
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let r = parvo(&[
+        "mip",
+        s(&a),
+        "builtin:checker:16",
+        "--out-dir",
+        s(&out),
+        "--ext",
+        "png",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    for name in [
+        "a_0.png",
+        "a_3.png",
+        "builtin-checker-16_0.png",
+        "builtin-checker-16_4.png",
+    ] {
+        assert!(out.join(name).exists(), "{name}");
+    }
+    // a.png and a.jpg would both become a.ktx2: the second is refused.
+    let r = parvo(&[
+        "mip",
+        s(&a),
+        s(&a_jpg),
+        "--out-dir",
+        s(&out),
+        "--ext",
+        "ktx2",
+    ]);
+    assert_eq!(r.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("is also the output of"), "{err}");
+    assert!(out.join("a.ktx2").exists());
+}

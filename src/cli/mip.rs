@@ -642,6 +642,9 @@ fn process(
         .collect::<anyhow::Result<_>>()?;
     levels.reverse();
     let build_s = t_build.elapsed().as_secs_f64();
+    if let Some(b) = bar {
+        b.set_message(format!("{}: writing {}", job.input, job.output.display()));
+    }
 
     let t_write = Instant::now();
     let save = SaveOptions {
