@@ -36,31 +36,33 @@ assert out.open(sys.argv[1], oiio.ImageSpec(n, n, 4, "uint8"))
 assert out.write_image(img)
 out.close()
 PY
-measure() { # NAME CMD... -> "wall_seconds peak_rss_kib"
+measure() { # NAME CMD... -> "wall_seconds peak_rss_kib cpu_seconds"
     local name="$1"; shift
     /usr/bin/time -v "$@" >"$WORK/$name.out" 2>"$WORK/$name.time"
     local wall rss
     wall=$(awk -F': ' '/Elapsed \(wall clock\)/ {n=split($2,t,":"); s=0; for(i=1;i<=n;i++) s=s*60+t[i]; print s}' "$WORK/$name.time")
     rss=$(awk -F': ' '/Maximum resident set size/ {print $2}' "$WORK/$name.time")
-    echo "$wall $rss"
+    cpu=$(awk -F': ' '/User time|System time/ {s+=$2} END {print s}' "$WORK/$name.time")
+    echo "$wall $rss $cpu"
 }
 PARVO_CMD=("$PARVO" mip "$SRC" -o "$WORK/parvo.exr" --filter box --compression zip --type f16 --threads "$THREADS")
 MAKETX_CMD=("$VENV_BIN/maketx" "$SRC" -o "$WORK/maketx.exr" --filter box -d half --compression zip --threads "$THREADS")
-read -r P_WALL P_RSS < <(measure parvo "${PARVO_CMD[@]}")
-read -r M_WALL M_RSS < <(measure maketx "${MAKETX_CMD[@]}")
+read -r P_WALL P_RSS P_CPU < <(measure parvo "${PARVO_CMD[@]}")
+read -r M_WALL M_RSS M_CPU < <(measure maketx "${MAKETX_CMD[@]}")
+LOAD="$(cut -d' ' -f1-3 /proc/loadavg)"
 P_SIZE=$(stat -c %s "$WORK/parvo.exr")
 M_SIZE=$(stat -c %s "$WORK/maketx.exr")
 echo
 echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(free -g | awk '/Mem:/ {print $2}') GiB; $(uname -sr)"
 echo "Versions: $("$PARVO" --version), maketx $("$VENV_BIN/oiiotool" --version) (pip install OpenImageIO)"
-echo "Input: 4096x4096 RGBA8 PNG; output: tiled 64x64 half EXR, 13 levels, box, zip; threads: $THREADS"
+echo "Input: 4096x4096 RGBA8 PNG; output: tiled 64x64 half EXR, 13 levels, box, zip; threads: $THREADS; load average after the runs: $LOAD"
 echo
-echo "| tool | wall time (s) | peak RSS (MiB) | output size (MiB) |"
-echo "| --- | ---: | ---: | ---: |"
-printf "| parvo mip | %.2f | %.0f | %.1f |\n" "$P_WALL" "$(echo "$P_RSS/1024" | bc -l)" "$(echo "$P_SIZE/1048576" | bc -l)"
-printf "| maketx | %.2f | %.0f | %.1f |\n" "$M_WALL" "$(echo "$M_RSS/1024" | bc -l)" "$(echo "$M_SIZE/1048576" | bc -l)"
-printf "\nparvo speed-up: %.2fx; peak memory ratio parvo/maketx: %.2f\n" \
-    "$(echo "$M_WALL/$P_WALL" | bc -l)" "$(echo "$P_RSS/$M_RSS" | bc -l)"
+echo "| tool | wall time (s) | CPU time, user+sys (s) | peak RSS (MiB) | output size (MiB) |"
+echo "| --- | ---: | ---: | ---: | ---: |"
+printf "| parvo mip | %.2f | %.2f | %.0f | %.1f |\n" "$P_WALL" "$P_CPU" "$(echo "$P_RSS/1024" | bc -l)" "$(echo "$P_SIZE/1048576" | bc -l)"
+printf "| maketx | %.2f | %.2f | %.0f | %.1f |\n" "$M_WALL" "$M_CPU" "$(echo "$M_RSS/1024" | bc -l)" "$(echo "$M_SIZE/1048576" | bc -l)"
+printf "\nparvo speed-up: wall %.2fx, CPU %.2fx; peak memory ratio parvo/maketx: %.2f\n" \
+    "$(echo "$M_WALL/$P_WALL" | bc -l)" "$(echo "$M_CPU/$P_CPU" | bc -l)" "$(echo "$P_RSS/$M_RSS" | bc -l)"
 echo
 echo "Commands:"
 echo "  ${PARVO_CMD[*]}" | sed "s#$WORK#\$WORK#g; s#$PWD/##g"

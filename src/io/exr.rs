@@ -324,23 +324,30 @@ fn tile_bytes(levels: &[Texture], index: &BlockIndex, order: &[usize]) -> Vec<u8
     for y in y0..y0 + bh {
         let start = (y * lw + x0) * ch;
         let end = start + bw * ch;
-        match lvl.texels() {
-            Texels::F16(v) => {
-                let row = &v[start..end];
-                for &c in order {
-                    raw.extend(row.iter().skip(c).step_by(ch).flat_map(|s| s.to_le_bytes()));
-                }
+        for &c in order {
+            match lvl.texels() {
+                Texels::F16(v) => gather(&v[start..end], ch, c, &mut raw, f16::to_le_bytes),
+                Texels::F32(v) => gather(&v[start..end], ch, c, &mut raw, f32::to_le_bytes),
+                _ => unreachable!("save checks for float texels"),
             }
-            Texels::F32(v) => {
-                let row = &v[start..end];
-                for &c in order {
-                    raw.extend(row.iter().skip(c).step_by(ch).flat_map(|s| s.to_le_bytes()));
-                }
-            }
-            _ => unreachable!("save checks for float texels"),
         }
     }
     raw
+}
+
+/// Append channel `c` of the interleaved texels `row` as bytes.
+fn gather<T: Copy, const N: usize>(
+    row: &[T],
+    ch: usize,
+    c: usize,
+    out: &mut Vec<u8>,
+    bytes: fn(T) -> [u8; N],
+) {
+    let at = out.len();
+    out.resize(at + row.len() / ch * N, 0);
+    for (o, px) in out[at..].chunks_exact_mut(N).zip(row.chunks_exact(ch)) {
+        o.copy_from_slice(&bytes(px[c]));
+    }
 }
 
 thread_local! {
