@@ -20,9 +20,9 @@
 //! - [`mip`]: level sizes, kernels, polyphase weights, the separable
 //!   reference path and the fast box paths, alpha coverage and normal
 //!   renormalisation, the chain builder.
-//! - [`io`]: loading (PNG, JPEG, TIFF, HDR, OpenEXR, KTX2, DDS, built-ins)
-//!   with decoder limits, and atomic saving of mip chains (tiled mip-mapped
-//!   EXR, KTX2, DDS, one PNG per level).
+//! - [`io`]: file formats: loading PNG, JPEG, TIFF, HDR, OpenEXR, KTX2,
+//!   DDS and built-ins with decoder limits, and atomic saving of mip chains
+//!   as tiled mip-mapped EXR, KTX2, DDS or one PNG per level.
 //!
 //! The library never prints and never panics on bad input: errors are
 //! [`Error`] values, long builds report through a progress callback.
