@@ -33,8 +33,8 @@ pub struct InfoArgs {
     #[arg(long, default_value_t = Limits::default().max_height, value_name = "N")]
     max_height: u32,
 
-    /// Largest decoded size in bytes.
-    #[arg(long, default_value_t = Limits::default().max_alloc, value_name = "BYTES")]
+    /// Largest decoded size, e.g. 4G, 512M, 1000000.
+    #[arg(long, default_value = "4G", value_name = "BYTES", value_parser = super::mip::parse_bytes)]
     max_alloc: u64,
 }
 
@@ -44,6 +44,8 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         max_height: args.max_height,
         max_alloc: args.max_alloc,
     };
+    // Decoder panics are reported as per-file errors by the library.
+    std::panic::set_hook(Box::new(|_| {}));
     let mut failed = false;
     for file in &args.files {
         match io::load(file, &limits) {

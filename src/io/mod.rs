@@ -203,15 +203,25 @@ pub fn load(spec: &str, limits: &Limits) -> Result<Loaded> {
             error: e,
         })?;
     let magic = &magic[..n];
-    if magic.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        exr::load(path, limits)
-    } else if magic.starts_with(ktx2::IDENTIFIER.as_slice()) {
-        ktx2::load(path, limits)
-    } else if magic.starts_with(b"DDS ") {
-        dds::load(path, limits)
-    } else {
-        load_image(path, limits)
-    }
+    // The decoders are dependencies; a panic in one on a malformed file
+    // becomes a decode error, never a crash of the caller.
+    std::panic::catch_unwind(|| {
+        if magic.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            exr::load(path, limits)
+        } else if magic.starts_with(ktx2::IDENTIFIER.as_slice()) {
+            ktx2::load(path, limits)
+        } else if magic.starts_with(b"DDS ") {
+            dds::load(path, limits)
+        } else {
+            load_image(path, limits)
+        }
+    })
+    .unwrap_or_else(|p| {
+        Err(Error::Decode {
+            format: "input",
+            reason: format!("decoder panicked: {}", atomic::panic_message(&*p)),
+        })
+    })
 }
 
 /// Load a texture as a mip chain: the file's own levels when it stores them
