@@ -294,3 +294,36 @@ fn impossible_type_for_the_container_is_a_per_file_error() {
     let o = parvo(&["mip", "builtin:checker:8", "-o", s(&out), "--levels", "2"]);
     assert_one_line_error(&o, "builtin:checker:8", "full chain");
 }
+
+#[test]
+fn killing_parvo_mid_write_leaves_the_old_output_or_a_complete_new_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("big.exr");
+    std::fs::write(&out, b"old").unwrap();
+    for delay_ms in [50u64, 400, 1200] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_parvo"))
+            .args([
+                "mip",
+                "builtin:zoneplate:2048",
+                "-o",
+                s(&out),
+                "--compression",
+                "zip",
+            ])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = child.kill();
+        let _ = child.wait();
+        let bytes = std::fs::read(&out).unwrap();
+        if bytes != b"old" {
+            // The run finished before the kill: the file must be whole.
+            let l = parvo::io::load(s(&out), &parvo::io::Limits::default())
+                .expect("a complete EXR at the destination");
+            assert_eq!(l.levels.len(), 12, "delay {delay_ms} ms");
+            std::fs::write(&out, b"old").unwrap();
+        }
+    }
+}
