@@ -327,3 +327,35 @@ fn killing_parvo_mid_write_leaves_the_old_output_or_a_complete_new_one() {
         }
     }
 }
+
+#[test]
+fn ctrl_c_removes_temporary_files_and_keeps_the_old_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("big.exr");
+    std::fs::write(&out, b"old").unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_parvo"))
+        .args(["mip", "builtin:zoneplate:2048", "-o", s(&out)])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until the temporary file exists (the write phase), then SIGINT.
+    let t0 = std::time::Instant::now();
+    while leftovers(dir.path()).is_empty() && t0.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let interrupted = !leftovers(dir.path()).is_empty();
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let o = child.wait_with_output().unwrap();
+    if interrupted && o.status.code() == Some(130) {
+        assert!(String::from_utf8_lossy(&o.stderr).contains("interrupted"));
+        assert_eq!(std::fs::read(&out).unwrap(), b"old");
+        assert!(leftovers(dir.path()).is_empty(), "temporary files removed");
+    } else {
+        // Finished before the signal arrived: the new file is complete.
+        assert!(parvo::io::load(s(&out), &parvo::io::Limits::default()).is_ok());
+    }
+}

@@ -330,6 +330,13 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     // Report panics (bugs in parvo or a dependency) as per-file errors, not
     // as the default multi-line message.
     std::panic::set_hook(Box::new(|_| {}));
+    // Ctrl-C: delete the temporary files being written (destinations are
+    // only ever replaced by a complete file) and exit like a shell does.
+    let _ = ctrlc::set_handler(|| {
+        io::atomic::remove_temporary_files();
+        eprintln!("parvo: interrupted; no output was left half-written");
+        std::process::exit(130);
+    });
     let limits = Limits {
         max_width: args.max_width,
         max_height: args.max_height,

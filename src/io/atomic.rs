@@ -6,8 +6,11 @@
 //! destination. An error, a panic inside a dependency's encoder (the `exr`
 //! crate panics on some invalid inputs, after having written part of the
 //! file) or an interrupt leaves the destination as it was: the temporary
-//! file is deleted when it is dropped (or, after a kill, left behind under a
-//! `.parvo-` name, never under the destination's name).
+//! file is deleted when it is dropped. Temporary files still being written
+//! are registered, so a signal handler (the CLI's Ctrl-C handler) can
+//! delete them with [`remove_temporary_files`] before exiting; after a
+//! SIGKILL one may be left behind under a `.parvo-` name, never under the
+//! destination's name.
 //!
 //! Several files that belong together (one PNG per mip level) are first all
 //! [`stage`]d, then all committed, so a failure in level 5 does not leave
@@ -18,25 +21,68 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use tempfile::NamedTempFile;
 
 use crate::error::{Error, Result};
 
+/// Temporary files that exist right now (created, not yet renamed or
+/// deleted).
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Delete every temporary file parvo is writing or has staged, for a
+/// signal handler about to exit the process. Destinations are untouched.
+pub fn remove_temporary_files() {
+    for p in live().drain(..) {
+        let _ = std::fs::remove_file(p);
+    }
+}
+
+/// A temporary file registered in [`LIVE`] while it exists.
+#[derive(Debug)]
+struct Tracked(Option<NamedTempFile>);
+
+impl Tracked {
+    fn new(tmp: NamedTempFile) -> Self {
+        live().push(tmp.path().to_path_buf());
+        Tracked(Some(tmp))
+    }
+    fn file(&self) -> &File {
+        self.0.as_ref().expect("present until persisted").as_file()
+    }
+    fn unregister(&self) {
+        if let Some(t) = &self.0 {
+            live().retain(|p| p != t.path());
+        }
+    }
+}
+
+impl Drop for Tracked {
+    fn drop(&mut self) {
+        self.unregister();
+    }
+}
+
 /// A fully written temporary file waiting to be renamed over `dest`.
 #[derive(Debug)]
 pub struct Staged {
-    tmp: NamedTempFile,
+    tmp: Tracked,
     dest: PathBuf,
 }
 
 impl Staged {
     /// Rename the temporary file over the destination.
-    pub fn commit(self) -> Result<()> {
-        let dest = self.dest;
-        self.tmp.persist(&dest).map_err(|e| Error::Io {
-            action: format!("cannot rename into {}", dest.display()),
-            path: dest.clone(),
+    pub fn commit(mut self) -> Result<()> {
+        self.tmp.unregister();
+        let tmp = self.tmp.0.take().expect("present until persisted");
+        tmp.persist(&self.dest).map_err(|e| Error::Io {
+            action: format!("cannot rename into {}", self.dest.display()),
+            path: self.dest.clone(),
             error: e.error,
         })?;
         Ok(())
@@ -88,13 +134,14 @@ where
                 std::io::Error::new(e.kind(), reason)
             },
         })?;
+    let tmp = Tracked::new(tmp);
     let io_err = |e: std::io::Error| Error::Io {
         path: dest.to_path_buf(),
         action: format!("cannot write {}", dest.display()),
         error: e,
     };
     {
-        let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
+        let mut w = BufWriter::with_capacity(1 << 20, tmp.file());
         match catch_unwind(AssertUnwindSafe(|| write(&mut w))) {
             Ok(r) => r?,
             Err(payload) => {
@@ -106,7 +153,7 @@ where
         }
         w.flush().map_err(io_err)?;
     }
-    tmp.as_file().sync_all().map_err(io_err)?;
+    tmp.file().sync_all().map_err(io_err)?;
     Ok(Staged {
         tmp,
         dest: dest.to_path_buf(),
@@ -152,5 +199,29 @@ mod tests {
         })
         .unwrap();
         assert_eq!(std::fs::read(&dest).unwrap(), b"new");
+    }
+
+    #[test]
+    fn staged_files_are_registered_until_committed_or_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = stage(&dir.path().join("a"), |w| {
+            w.write_all(b"a").unwrap();
+            Ok(())
+        })
+        .unwrap();
+        let tmp_path = a.tmp.0.as_ref().unwrap().path().to_path_buf();
+        assert!(live().contains(&tmp_path));
+        a.commit().unwrap();
+        assert!(!live().contains(&tmp_path));
+        let b = stage(&dir.path().join("b"), |w| {
+            w.write_all(b"b").unwrap();
+            Ok(())
+        })
+        .unwrap();
+        let b_tmp = b.tmp.0.as_ref().unwrap().path().to_path_buf();
+        remove_temporary_files();
+        assert!(!b_tmp.exists(), "removed by the signal-handler path");
+        drop(b);
+        assert!(!dir.path().join("b").exists());
     }
 }
