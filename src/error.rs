@@ -66,6 +66,38 @@ pub enum Error {
     /// combination.
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// A file or directory could not be opened, read or written.
+    #[error("{action}: {error}")]
+    Io {
+        /// The file or directory involved.
+        path: std::path::PathBuf,
+        /// What was being done ("cannot open", "cannot rename into place", ...).
+        action: String,
+        /// The operating system's error (part of the message, so not
+        /// also reported as the error's `source`).
+        error: std::io::Error,
+    },
+    /// A file's contents could not be decoded: corrupt, truncated, or a
+    /// variant of the format parvo does not support.
+    #[error("cannot decode {format}: {reason}")]
+    Decode {
+        /// The file format ("PNG", "OpenEXR", ...).
+        format: &'static str,
+        /// What is wrong, in one line.
+        reason: String,
+    },
+    /// A texture could not be encoded in the requested file format.
+    #[error("cannot write {format}: {reason}")]
+    Encode {
+        /// The file format ("OpenEXR", "KTX2", ...).
+        format: &'static str,
+        /// What is wrong, in one line.
+        reason: String,
+    },
+    /// A decoder limit (width, height, allocation) refused the file; see
+    /// `io::Limits` for the defaults and how to raise them.
+    #[error("limit exceeded: {0}")]
+    Limits(String),
 }
 
 impl Error {

@@ -31,6 +31,9 @@
 //!   [`TexelSink`] that sees every texel read; batch sampling on rayon.
 //! - [`sat`]: summed-area tables with exact integer or bounded-error float
 //!   accumulators, O(1) box sums under every wrap mode, the SAT sampler.
+//! - [`io`]: file formats: loading PNG, JPEG, TIFF, HDR, OpenEXR, KTX2,
+//!   DDS and built-ins with decoder limits, and atomic saving of mip chains
+//!   as tiled mip-mapped EXR, KTX2, DDS or one PNG per level.
 //!
 //! The library never prints and never panics on bad input: errors are
 //! [`Error`] values, long builds report through a progress callback.
@@ -48,6 +51,7 @@
 
 pub mod builtin;
 pub mod error;
+pub mod io;
 pub mod mip;
 pub mod sample;
 pub mod sat;

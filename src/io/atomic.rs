@@ -1,0 +1,227 @@
+//! Atomic writes: an output is either the complete new file or untouched.
+//!
+//! Every writer in [`crate::io`] writes into a [`tempfile::NamedTempFile`]
+//! created in the destination's directory (so the final rename never crosses
+//! a file system), flushes and syncs it, and only then renames it over the
+//! destination. An error, a panic inside a dependency's encoder (the `exr`
+//! crate panics on some invalid inputs, after having written part of the
+//! file) or an interrupt leaves the destination as it was: the temporary
+//! file is deleted when it is dropped. Temporary files still being written
+//! are registered, so a signal handler (the CLI's Ctrl-C handler) can
+//! delete them with [`remove_temporary_files`] before exiting; after a
+//! SIGKILL one may be left behind under a `.parvo-` name, never under the
+//! destination's name.
+//!
+//! Several files that belong together (one PNG per mip level) are first all
+//! [`stage`]d, then all committed, so a failure in level 5 does not leave
+//! levels 0–4 of a new chain next to the old levels 5–12.
+
+use std::any::Any;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use tempfile::NamedTempFile;
+
+use crate::error::{Error, Result};
+
+/// Temporary files that exist right now (created, not yet renamed or
+/// deleted).
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Delete every temporary file parvo is writing or has staged, for a
+/// signal handler about to exit the process. Destinations are untouched.
+pub fn remove_temporary_files() {
+    for p in live().drain(..) {
+        let _ = std::fs::remove_file(p);
+    }
+}
+
+/// A temporary file registered in [`LIVE`] while it exists.
+#[derive(Debug)]
+struct Tracked(Option<NamedTempFile>);
+
+impl Tracked {
+    fn new(tmp: NamedTempFile) -> Self {
+        live().push(tmp.path().to_path_buf());
+        Tracked(Some(tmp))
+    }
+    fn file(&self) -> &File {
+        self.0.as_ref().expect("present until persisted").as_file()
+    }
+    fn unregister(&self) {
+        if let Some(t) = &self.0 {
+            live().retain(|p| p != t.path());
+        }
+    }
+}
+
+impl Drop for Tracked {
+    fn drop(&mut self) {
+        self.unregister();
+    }
+}
+
+/// A fully written temporary file waiting to be renamed over `dest`.
+#[derive(Debug)]
+pub struct Staged {
+    tmp: Tracked,
+    dest: PathBuf,
+}
+
+impl Staged {
+    /// Rename the temporary file over the destination.
+    pub fn commit(mut self) -> Result<()> {
+        self.tmp.unregister();
+        let tmp = self.tmp.0.take().expect("present until persisted");
+        tmp.persist(&self.dest).map_err(|e| Error::Io {
+            action: format!("cannot rename into {}", self.dest.display()),
+            path: self.dest.clone(),
+            error: e.error,
+        })?;
+        Ok(())
+    }
+
+    /// The destination this file will be renamed to.
+    pub fn dest(&self) -> &Path {
+        &self.dest
+    }
+}
+
+/// Write `dest` atomically with `write` (see the module docs).
+pub fn write<F>(dest: &Path, write: F) -> Result<()>
+where
+    F: FnOnce(&mut BufWriter<&File>) -> Result<()>,
+{
+    stage(dest, write)?.commit()
+}
+
+/// Write the contents of `dest` into a temporary file beside it, without
+/// renaming it yet. Dropping the result deletes the temporary file.
+pub fn stage<F>(dest: &Path, write: F) -> Result<Staged>
+where
+    F: FnOnce(&mut BufWriter<&File>) -> Result<()>,
+{
+    if dest.is_dir() {
+        return Err(Error::Io {
+            path: dest.to_path_buf(),
+            action: format!("cannot write {}", dest.display()),
+            error: std::io::Error::other("it is a directory"),
+        });
+    }
+    let dir = match dest.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let tmp = tempfile::Builder::new()
+        .prefix(".parvo-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| Error::Io {
+            path: dir.to_path_buf(),
+            action: format!("cannot create a file in {}", dir.display()),
+            // tempfile appends the random temporary name; keep only the
+            // operating system's reason.
+            error: {
+                let msg = e.to_string();
+                let reason = msg.split(" at path ").next().unwrap_or(&msg).to_string();
+                std::io::Error::new(e.kind(), reason)
+            },
+        })?;
+    let tmp = Tracked::new(tmp);
+    let io_err = |e: std::io::Error| Error::Io {
+        path: dest.to_path_buf(),
+        action: format!("cannot write {}", dest.display()),
+        error: e,
+    };
+    {
+        let mut w = BufWriter::with_capacity(1 << 20, tmp.file());
+        match catch_unwind(AssertUnwindSafe(|| write(&mut w))) {
+            Ok(r) => r?,
+            Err(payload) => {
+                return Err(Error::Encode {
+                    format: "output",
+                    reason: format!("encoder panicked: {}", panic_message(&*payload)),
+                });
+            }
+        }
+        w.flush().map_err(io_err)?;
+    }
+    tmp.file().sync_all().map_err(io_err)?;
+    Ok(Staged {
+        tmp,
+        dest: dest.to_path_buf(),
+    })
+}
+
+/// Text of a panic payload (`&str` or `String`), or a placeholder.
+pub fn panic_message(payload: &(dyn Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        s.to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failed_and_panicking_writers_leave_the_destination_untouched() {
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("out.bin");
+        std::fs::write(&dest, b"old").unwrap();
+        let e = write(&dest, |w| {
+            w.write_all(b"partial").unwrap();
+            Err(Error::InvalidOption("boom".into()))
+        });
+        assert!(e.is_err());
+        let e = write(&dest, |w| {
+            w.write_all(b"partial").unwrap();
+            panic!("dependency bug")
+        });
+        assert!(e.unwrap_err().to_string().contains("dependency bug"));
+        assert_eq!(std::fs::read(&dest).unwrap(), b"old");
+        // Only the destination is left: no temporary files.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        write(&dest, |w| {
+            w.write_all(b"new").unwrap();
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(std::fs::read(&dest).unwrap(), b"new");
+    }
+
+    #[test]
+    fn staged_files_are_registered_until_committed_or_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = stage(&dir.path().join("a"), |w| {
+            w.write_all(b"a").unwrap();
+            Ok(())
+        })
+        .unwrap();
+        let tmp_path = a.tmp.0.as_ref().unwrap().path().to_path_buf();
+        assert!(live().contains(&tmp_path));
+        a.commit().unwrap();
+        assert!(!live().contains(&tmp_path));
+        let b = stage(&dir.path().join("b"), |w| {
+            w.write_all(b"b").unwrap();
+            Ok(())
+        })
+        .unwrap();
+        let b_tmp = b.tmp.0.as_ref().unwrap().path().to_path_buf();
+        remove_temporary_files();
+        assert!(!b_tmp.exists(), "removed by the signal-handler path");
+        drop(b);
+        assert!(!dir.path().join("b").exists());
+    }
+}

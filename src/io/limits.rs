@@ -1,0 +1,86 @@
+//! Limits against decompression bombs.
+//!
+//! A 60-byte PNG can declare 100000×100000 texels; a few bytes of EXR header
+//! can declare a mip chain of terabytes. Every decoder in [`crate::io`] checks
+//! the declared size against a [`Limits`] *before* allocating: the `image`
+//! codecs through [`image::Limits`], OpenEXR, KTX2 and DDS through
+//! [`Limits::check`] on their headers.
+
+use crate::error::{Error, Result};
+
+/// Maximum width, height and allocation a decoder may use.
+///
+/// Defaults: 65536 × 65536 texels and 4 GiB for the decoded texels (a
+/// 16384² RGBA f32 image, or a 32768² RGBA8 one). The CLI raises them with
+/// `--max-width`, `--max-height` and `--max-alloc`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// Largest accepted width in texels.
+    pub max_width: u32,
+    /// Largest accepted height in texels.
+    pub max_height: u32,
+    /// Largest accepted size of the decoded texels in bytes (all levels).
+    pub max_alloc: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_width: 65536,
+            max_height: 65536,
+            max_alloc: 4 << 30,
+        }
+    }
+}
+
+impl Limits {
+    /// No limits at all (trusted input only).
+    pub fn none() -> Self {
+        Limits {
+            max_width: u32::MAX,
+            max_height: u32::MAX,
+            max_alloc: u64::MAX,
+        }
+    }
+
+    /// Check a declared size: `width × height` texels and `bytes` of decoded
+    /// data (which the caller computes for all the levels it will decode).
+    pub fn check(&self, width: u64, height: u64, bytes: u64) -> Result<()> {
+        if width > self.max_width as u64 || height > self.max_height as u64 {
+            return Err(Error::Limits(format!(
+                "image declares {width}x{height}, more than the {}x{} allowed (raise with --max-width/--max-height)",
+                self.max_width, self.max_height
+            )));
+        }
+        if bytes > self.max_alloc {
+            return Err(Error::Limits(format!(
+                "image needs {} MiB, more than the {} MiB allowed (raise with --max-alloc)",
+                bytes.div_ceil(1 << 20),
+                self.max_alloc / (1 << 20)
+            )));
+        }
+        Ok(())
+    }
+
+    /// The same limits for the `image` crate's decoders.
+    pub fn to_image(&self) -> image::Limits {
+        let mut l = image::Limits::default();
+        l.max_image_width = Some(self.max_width);
+        l.max_image_height = Some(self.max_height);
+        l.max_alloc = Some(self.max_alloc);
+        l
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn oversized_declarations_are_refused() {
+        let l = Limits::default();
+        assert!(l.check(100_000, 100_000, 0).is_err());
+        assert!(l.check(4096, 4096, 5 << 30).is_err());
+        assert!(l.check(4096, 4096, 4096 * 4096 * 4).is_ok());
+    }
+}

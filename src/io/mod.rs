@@ -1,0 +1,543 @@
+//! Loading and saving textures: the `image` codecs (PNG, JPEG, TIFF,
+//! Radiance HDR), OpenEXR (scanline, tiled, mip-mapped) via `exr`, KTX 2.0
+//! (written by hand, read with `ktx2`), DDS via `ddsfile`, and one PNG per
+//! mip level.
+//!
+//! Design decisions:
+//! - Files are recognised by their first bytes (EXR, KTX2, DDS magic
+//!   numbers), everything else goes to `image`'s format guesser, so a
+//!   misnamed file still loads and a wrong extension is never trusted.
+//! - Channels are kept as they are: grey stays one channel, grey + alpha
+//!   two. The loader records what it knows about the source
+//!   ([`SourceInfo`]): its own mip levels, wrap modes, tiling, attributes.
+//! - Colour space: 8-bit PNG and JPEG load as sRGB, everything else as
+//!   linear (what `--color auto` means); callers reinterpret when they know
+//!   better.
+//! - Every decoder checks the declared size against [`Limits`] before it
+//!   allocates; every writer goes through [`atomic`].
+
+pub mod atomic;
+pub mod dds;
+pub mod exr;
+pub mod ktx2;
+pub mod limits;
+pub mod png_levels;
+
+use std::borrow::Cow;
+use std::fmt;
+use std::io::Read;
+use std::path::Path;
+
+use half::slice::HalfFloatSliceExt;
+
+use crate::error::{Error, Result};
+use crate::mip::{self, MipChain, MipOptions, Rounding};
+use crate::texel::{ChannelType, ColorSpace, Format, Texels};
+use crate::texture::Texture;
+use crate::wrap::Wrap;
+
+pub use limits::Limits;
+
+/// A file format parvo reads or writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FileFormat {
+    /// A procedural `builtin:` texture.
+    Builtin,
+    /// PNG.
+    Png,
+    /// JPEG.
+    Jpeg,
+    /// TIFF.
+    Tiff,
+    /// Radiance RGBE (.hdr).
+    Hdr,
+    /// OpenEXR.
+    Exr,
+    /// KTX 2.0.
+    Ktx2,
+    /// DirectDraw Surface.
+    Dds,
+}
+
+impl FileFormat {
+    /// Display name ("PNG", "OpenEXR", ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            FileFormat::Builtin => "builtin",
+            FileFormat::Png => "PNG",
+            FileFormat::Jpeg => "JPEG",
+            FileFormat::Tiff => "TIFF",
+            FileFormat::Hdr => "Radiance HDR",
+            FileFormat::Exr => "OpenEXR",
+            FileFormat::Ktx2 => "KTX2",
+            FileFormat::Dds => "DDS",
+        }
+    }
+}
+
+impl fmt::Display for FileFormat {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What a loader learned about the source besides its texels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SourceInfo {
+    /// The file format.
+    pub format: FileFormat,
+    /// True when the file stores its own mip levels (more than one).
+    pub own_mips: bool,
+    /// Size rounding of the stored mip levels.
+    pub rounding: Rounding,
+    /// Wrap modes stored in the file (EXR `wrapmodes`), if any.
+    pub wrap: Option<Wrap>,
+    /// Tile size of a tiled file.
+    pub tile: Option<(u32, u32)>,
+    /// Channel names as stored (EXR), or implied by the layout.
+    pub channel_names: Vec<String>,
+    /// Other metadata as name/value text, sorted by name.
+    pub attributes: Vec<(String, String)>,
+}
+
+impl SourceInfo {
+    fn new(format: FileFormat, channels: u8) -> Self {
+        SourceInfo {
+            format,
+            own_mips: false,
+            rounding: Rounding::Down,
+            wrap: None,
+            tile: None,
+            channel_names: layout_names(channels),
+            attributes: Vec::new(),
+        }
+    }
+
+    /// The value of attribute `name`, if present.
+    pub fn attribute(&self, name: &str) -> Option<&str> {
+        self.attributes
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+fn layout_names(channels: u8) -> Vec<String> {
+    let names: &[&str] = match channels {
+        1 => &["Y"],
+        2 => &["Y", "A"],
+        3 => &["R", "G", "B"],
+        _ => &["R", "G", "B", "A"],
+    };
+    names.iter().map(|s| s.to_string()).collect()
+}
+
+/// A loaded texture: level 0 and, when the file had them, its own mip
+/// levels (level 0 first), plus what the file said about itself.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// Level 0 first; more than one entry only when the file stores mips.
+    pub levels: Vec<Texture>,
+    /// Source metadata.
+    pub info: SourceInfo,
+}
+
+impl Loaded {
+    /// Level 0.
+    pub fn base(&self) -> &Texture {
+        &self.levels[0]
+    }
+
+    /// Consume into level 0.
+    pub fn into_base(mut self) -> Texture {
+        self.levels.swap_remove(0)
+    }
+}
+
+/// Load a texture file or a `builtin:` name (see the module docs).
+pub fn load(spec: &str, limits: &Limits) -> Result<Loaded> {
+    if crate::builtin::is_builtin(spec) {
+        let (kind, size) = crate::builtin::parse(spec)?;
+        limits.check(size as u64, size as u64, size as u64 * size as u64 * 4)?;
+        let t = crate::builtin::generate(kind, size)?;
+        let info = SourceInfo::new(FileFormat::Builtin, t.format().channels);
+        return Ok(Loaded {
+            levels: vec![t],
+            info,
+        });
+    }
+    let path = Path::new(spec);
+    let meta = std::fs::metadata(path).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        action: "cannot open".into(),
+        error: e,
+    })?;
+    if meta.is_dir() {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            action: "cannot read".into(),
+            error: std::io::Error::other("it is a directory, not a texture file"),
+        });
+    }
+    if meta.len() == 0 {
+        return Err(Error::Decode {
+            format: "input",
+            reason: "the file is empty".into(),
+        });
+    }
+    let mut magic = [0u8; 12];
+    let n = std::fs::File::open(path)
+        .and_then(|mut f| {
+            let mut n = 0;
+            while n < magic.len() {
+                match f.read(&mut magic[n..])? {
+                    0 => break,
+                    k => n += k,
+                }
+            }
+            Ok(n)
+        })
+        .map_err(|e| Error::Io {
+            path: path.to_path_buf(),
+            action: "cannot read".into(),
+            error: e,
+        })?;
+    let magic = &magic[..n];
+    // The decoders are dependencies; a panic in one on a malformed file
+    // becomes a decode error, never a crash of the caller.
+    std::panic::catch_unwind(|| {
+        if magic.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            exr::load(path, limits)
+        } else if magic.starts_with(ktx2::IDENTIFIER.as_slice()) {
+            ktx2::load(path, limits)
+        } else if magic.starts_with(b"DDS ") {
+            dds::load(path, limits)
+        } else {
+            load_image(path, limits)
+        }
+    })
+    .unwrap_or_else(|p| {
+        Err(Error::Decode {
+            format: "input",
+            reason: format!("decoder panicked: {}", atomic::panic_message(&*p)),
+        })
+    })
+}
+
+/// Load a texture as a mip chain: the file's own levels when it stores them
+/// (EXR, KTX2, DDS), otherwise a box-filtered chain built from level 0
+/// (wrap modes from the file when it names them, else repeat).
+pub fn load_chain(spec: &str, limits: &Limits) -> Result<MipChain> {
+    let loaded = load(spec, limits)?;
+    let options = MipOptions {
+        rounding: loaded.info.rounding,
+        wrap: loaded.info.wrap.unwrap_or_default(),
+        ..MipOptions::default()
+    };
+    if loaded.levels.len() > 1 {
+        MipChain::from_levels(loaded.levels, options)
+    } else {
+        mip::build(loaded.into_base(), &options)
+    }
+}
+
+fn load_image(path: &Path, limits: &Limits) -> Result<Loaded> {
+    use image::{DynamicImage, ImageFormat};
+    let decode = |reason: String| Error::Decode {
+        format: "image",
+        reason,
+    };
+    let mut reader = image::ImageReader::open(path)
+        .map_err(|e| Error::Io {
+            path: path.to_path_buf(),
+            action: "cannot open".into(),
+            error: e,
+        })?
+        .with_guessed_format()
+        .map_err(|e| decode(e.to_string()))?;
+    let file_format = match reader.format() {
+        Some(ImageFormat::Png) => FileFormat::Png,
+        Some(ImageFormat::Jpeg) => FileFormat::Jpeg,
+        Some(ImageFormat::Tiff) => FileFormat::Tiff,
+        Some(ImageFormat::Hdr) => FileFormat::Hdr,
+        _ => {
+            return Err(decode(
+                "unrecognised format (parvo reads PNG, JPEG, TIFF, Radiance HDR, OpenEXR, KTX2, DDS)"
+                    .into(),
+            ));
+        }
+    };
+    reader.limits(limits.to_image());
+    let img = reader.decode().map_err(|e| match e {
+        image::ImageError::Limits(l) => Error::Limits(format!(
+            "{l} (raise with --max-width/--max-height/--max-alloc)"
+        )),
+        other => Error::Decode {
+            format: file_format.name(),
+            reason: other.to_string(),
+        },
+    })?;
+    let (w, h) = (img.width(), img.height());
+    let srgb8 = matches!(file_format, FileFormat::Png | FileFormat::Jpeg);
+    let f = |ch: u8, ty: ChannelType| {
+        let cs = if srgb8 && ty == ChannelType::U8 {
+            ColorSpace::Srgb
+        } else {
+            ColorSpace::Linear
+        };
+        Format::new(ch, ty, cs)
+    };
+    use ChannelType::*;
+    let tex = match img {
+        DynamicImage::ImageLuma8(b) => Texture::from_u8(w, h, f(1, U8), b.into_raw()),
+        DynamicImage::ImageLumaA8(b) => Texture::from_u8(w, h, f(2, U8), b.into_raw()),
+        DynamicImage::ImageRgb8(b) => Texture::from_u8(w, h, f(3, U8), b.into_raw()),
+        DynamicImage::ImageRgba8(b) => Texture::from_u8(w, h, f(4, U8), b.into_raw()),
+        DynamicImage::ImageLuma16(b) => Texture::from_u16(w, h, f(1, U16), b.into_raw()),
+        DynamicImage::ImageLumaA16(b) => Texture::from_u16(w, h, f(2, U16), b.into_raw()),
+        DynamicImage::ImageRgb16(b) => Texture::from_u16(w, h, f(3, U16), b.into_raw()),
+        DynamicImage::ImageRgba16(b) => Texture::from_u16(w, h, f(4, U16), b.into_raw()),
+        DynamicImage::ImageRgb32F(b) => Texture::from_f32(w, h, f(3, F32), b.into_raw()),
+        other => Texture::from_f32(w, h, f(4, F32), other.into_rgba32f().into_raw()),
+    }?;
+    let info = SourceInfo::new(file_format, tex.format().channels);
+    Ok(Loaded {
+        levels: vec![tex],
+        info,
+    })
+}
+
+/// The stored values as little-endian bytes (borrowed on little-endian
+/// machines).
+pub fn le_bytes(texels: &Texels) -> Cow<'_, [u8]> {
+    #[cfg(target_endian = "little")]
+    {
+        match texels {
+            Texels::U8(v) => Cow::Borrowed(v.as_slice()),
+            Texels::U16(v) => Cow::Borrowed(bytemuck::cast_slice(v)),
+            Texels::F16(v) => Cow::Borrowed(bytemuck::cast_slice(v.reinterpret_cast())),
+            Texels::F32(v) => Cow::Borrowed(bytemuck::cast_slice(v)),
+        }
+    }
+    #[cfg(not(target_endian = "little"))]
+    {
+        match texels {
+            Texels::U8(v) => Cow::Borrowed(v.as_slice()),
+            Texels::U16(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+            Texels::F16(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+            Texels::F32(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+        }
+    }
+}
+
+/// Texels of the given type from little-endian bytes (length must be a
+/// multiple of the type's size).
+pub fn texels_from_le(ty: ChannelType, bytes: &[u8]) -> Texels {
+    match ty {
+        ChannelType::U8 => Texels::U8(bytes.to_vec()),
+        ChannelType::U16 => Texels::U16(
+            bytes
+                .chunks_exact(2)
+                .map(|b| u16::from_le_bytes([b[0], b[1]]))
+                .collect(),
+        ),
+        ChannelType::F16 => Texels::F16(
+            bytes
+                .chunks_exact(2)
+                .map(|b| half::f16::from_le_bytes([b[0], b[1]]))
+                .collect(),
+        ),
+        ChannelType::F32 => Texels::F32(
+            bytes
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect(),
+        ),
+    }
+}
+
+/// The fingerprint `--update` compares: a 128-bit XXH3 hash of level 0's
+/// format, size and texel bytes and of `options` (every setting that changes
+/// the output), as 32 hex digits.
+pub fn fingerprint(level0: &Texture, options: &str) -> String {
+    let mut h = xxhash_rust::xxh3::Xxh3::new();
+    h.update(
+        format!(
+            "{}x{} {}|{}|",
+            level0.width(),
+            level0.height(),
+            level0.format(),
+            options
+        )
+        .as_bytes(),
+    );
+    h.update(&le_bytes(level0.texels()));
+    format!("{:032x}", h.digest128())
+}
+
+/// Container of an output file, chosen from its name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum OutputKind {
+    /// `.exr`: tiled, mip-mapped OpenEXR.
+    Exr,
+    /// `.ktx2`: KTX 2.0, uncompressed.
+    Ktx2,
+    /// `.dds`: DDS with a DX10 header, uncompressed.
+    Dds,
+    /// A name containing `{level}`: one PNG per level.
+    PngLevels,
+}
+
+impl OutputKind {
+    /// Pick the container for an output name: `{level}` in the name means
+    /// one PNG per level, otherwise the extension decides.
+    pub fn from_path(path: &Path) -> Result<Self> {
+        let s = path.to_string_lossy();
+        if s.contains("{level}") {
+            return Ok(OutputKind::PngLevels);
+        }
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "exr" => Ok(OutputKind::Exr),
+            "ktx2" => Ok(OutputKind::Ktx2),
+            "dds" => Ok(OutputKind::Dds),
+            _ => Err(Error::InvalidOption(format!(
+                "output `{s}`: unknown extension (use .exr, .ktx2, .dds, or a name with {{level}} for one PNG per level)"
+            ))),
+        }
+    }
+
+    /// Channel types the container can store.
+    pub fn supports(self, ty: ChannelType) -> bool {
+        match self {
+            OutputKind::Exr => ty.is_float(),
+            OutputKind::PngLevels => !ty.is_float(),
+            OutputKind::Ktx2 | OutputKind::Dds => true,
+        }
+    }
+}
+
+/// Everything a writer needs besides the levels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SaveOptions {
+    /// Wrap modes to record.
+    pub wrap: Wrap,
+    /// EXR tile size.
+    pub tile: (u32, u32),
+    /// EXR compression.
+    pub compression: exr::ExrCompression,
+    /// Fingerprint to record (EXR attribute, KTX2 key/value).
+    pub fingerprint: Option<String>,
+    /// More attributes to record (EXR, KTX2).
+    pub attributes: Vec<(String, String)>,
+}
+
+impl Default for SaveOptions {
+    fn default() -> Self {
+        SaveOptions {
+            wrap: Wrap::default(),
+            tile: (64, 64),
+            compression: exr::ExrCompression::Zip,
+            fingerprint: None,
+            attributes: Vec::new(),
+        }
+    }
+}
+
+/// Write `levels` (level 0 first, sizes following `rounding`) to `path`
+/// atomically in the container `kind`.
+pub fn save(
+    levels: &[Texture],
+    rounding: Rounding,
+    path: &Path,
+    kind: OutputKind,
+    options: &SaveOptions,
+) -> Result<()> {
+    let first = levels
+        .first()
+        .ok_or_else(|| Error::InvalidOption("nothing to write: no levels".into()))?;
+    if !kind.supports(first.channel_type()) {
+        return Err(Error::InvalidOption(format!(
+            "{kind:?} output cannot store {} texels",
+            first.channel_type()
+        )));
+    }
+    for (k, l) in levels.iter().enumerate() {
+        let want = mip::level_size(first.width(), first.height(), k as u32, rounding);
+        if (l.width(), l.height()) != want || l.format() != first.format() {
+            return Err(Error::InvalidOption(format!(
+                "level {k} is {}x{} {}, expected {}x{} {}",
+                l.width(),
+                l.height(),
+                l.format(),
+                want.0,
+                want.1,
+                first.format()
+            )));
+        }
+    }
+    match kind {
+        OutputKind::Exr => exr::save(levels, rounding, path, options),
+        OutputKind::Ktx2 => ktx2::save(levels, path, options),
+        OutputKind::Dds => dds::save(levels, path),
+        OutputKind::PngLevels => png_levels::save(levels, path),
+    }
+}
+
+/// The fingerprint stored in an existing output (EXR attribute or KTX2
+/// key/value), or `None` when there is none or the file cannot be read.
+pub fn stored_fingerprint(path: &Path, kind: OutputKind) -> Option<String> {
+    match kind {
+        OutputKind::Exr => exr::stored_fingerprint(path),
+        OutputKind::Ktx2 => ktx2::stored_fingerprint(path),
+        OutputKind::Dds | OutputKind::PngLevels => None,
+    }
+}
+
+/// Widen a texture to `channels` channels: grey is replicated into RGB, a
+/// missing alpha becomes opaque. Used where a container has no format for
+/// the source layout (DDS has no RGB8, KTX2's `R8G8_SRGB` would decode
+/// alpha as sRGB).
+pub fn expand_channels(t: &Texture, channels: u8) -> Result<Texture> {
+    let from = t.format().channels;
+    if from == channels {
+        return Ok(t.clone());
+    }
+    if channels < from || !(3..=4).contains(&channels) {
+        return Err(Error::InvalidOption(format!(
+            "cannot widen {from} channels to {channels}"
+        )));
+    }
+    // Source channel feeding each destination channel; `None` = opaque alpha.
+    let map: Vec<Option<usize>> = match (from, channels) {
+        (1, 3) => vec![Some(0), Some(0), Some(0)],
+        (1, 4) => vec![Some(0), Some(0), Some(0), None],
+        (2, 4) => vec![Some(0), Some(0), Some(0), Some(1)],
+        (2, 3) => vec![Some(0), Some(0), Some(0)],
+        (3, 4) => vec![Some(0), Some(1), Some(2), None],
+        _ => unreachable!("checked above"),
+    };
+    fn widen<T: Copy>(v: &[T], from: usize, map: &[Option<usize>], one: T) -> Vec<T> {
+        let mut out = Vec::with_capacity(v.len() / from * map.len());
+        for px in v.chunks_exact(from) {
+            out.extend(map.iter().map(|m| m.map_or(one, |i| px[i])));
+        }
+        out
+    }
+    let f = from as usize;
+    let texels = match t.texels() {
+        Texels::U8(v) => Texels::U8(widen(v, f, &map, u8::MAX)),
+        Texels::U16(v) => Texels::U16(widen(v, f, &map, u16::MAX)),
+        Texels::F16(v) => Texels::F16(widen(v, f, &map, half::f16::ONE)),
+        Texels::F32(v) => Texels::F32(widen(v, f, &map, 1.0)),
+    };
+    let mut format = t.format();
+    format.channels = channels;
+    Texture::from_texels(t.width(), t.height(), format, texels)
+}
+
+/// Name of the fingerprint attribute (EXR) and key (KTX2).
+pub const FINGERPRINT_KEY: &str = "parvo:fingerprint";
