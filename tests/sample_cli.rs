@@ -164,9 +164,10 @@ fn usage_errors_exit_with_2() {
             String::from_utf8_lossy(&o.stderr)
         );
     }
-    // Files are not readable yet: a clear error, exit 1.
+    // A missing file: a clear error naming it, exit 1.
     let o = run(&["no-such-file.exr"], "");
     assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no-such-file.exr"));
 }
 
 #[test]
@@ -226,4 +227,39 @@ fn sat_filter_averages_the_footprint_box() {
         "{} vs {want2}",
         lines[1][0]
     );
+}
+
+#[test]
+fn a_mip_mapped_exr_written_by_parvo_mip_samples_like_its_source() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("checker.exr");
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_parvo"))
+        .args(["mip", "builtin:checker:16", "-o"])
+        .arg(&exr)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    // Trilinear at several footprints reads the file's own levels; the EXR
+    // holds linear half floats of the same sRGB checker, its levels built
+    // in f32 (the built-in's levels are 8-bit sRGB, within one code).
+    let queries = "0.3 0.7 0 0 0 0\n0.3 0.7 0.125 0 0 0.125\n0.5 0.5 0.25 0 0 0.25\n";
+    let a = run(&["builtin:checker:16", "--filter", "trilinear"], queries);
+    let b = run(&[exr.to_str().unwrap(), "--filter", "trilinear"], queries);
+    assert_eq!(
+        b.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&b.stderr)
+    );
+    let parse = |o: &std::process::Output| -> Vec<f32> {
+        String::from_utf8_lossy(&o.stdout)
+            .split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    let (a, b) = (parse(&a), parse(&b));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x - y).abs() <= 0.01, "{x} vs {y}");
+    }
 }

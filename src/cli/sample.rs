@@ -16,7 +16,7 @@
 use std::io::{self, BufRead, BufWriter, Write};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow};
 use parvo::sample::{Filter, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
 use parvo::{MipChain, Wrap};
 
@@ -126,14 +126,10 @@ impl SampleArgs {
 /// here: a mip-mapped file keeps its own levels, a plain image gets box
 /// mips built on load.
 fn load_chain(spec: &str) -> Result<MipChain> {
-    if parvo::builtin::is_builtin(spec) {
-        let tex = parvo::builtin::load(spec)?;
-        return Ok(parvo::mip::build(tex, &parvo::MipOptions::default())?);
-    }
-    bail!(
-        "cannot read `{spec}`: reading texture files arrives with parvo io; \
-         use builtin:checker[:SIZE] or builtin:zoneplate[:SIZE] for now"
-    )
+    // A mip-mapped EXR/KTX2/DDS keeps its own levels; anything else gets
+    // box mips built on load (`parvo::io::load_chain`).
+    parvo::io::load_chain(spec, &parvo::io::Limits::default())
+        .with_context(|| format!("cannot read texture `{spec}`"))
 }
 
 pub fn run(args: SampleArgs) -> Result<ExitCode> {
