@@ -127,3 +127,37 @@ fn one_by_one_is_a_single_level_chain() {
     assert_eq!(chain.len(), 1);
     assert_eq!(chain.levels()[0], tex);
 }
+
+#[test]
+fn nan_anywhere_is_reported_exactly_whatever_the_filter_and_level_count() {
+    // The Error policy defers its scan to level 1; a NaN or Inf in any
+    // texel, channel or position must still be found and named.
+    let f = Format::new(4, ChannelType::F32, ColorSpace::Linear);
+    let mut rng = Rng(0xba1d);
+    for filter in MipFilter::ALL {
+        for &(w, h) in &[(1u32, 1u32), (7, 1), (16, 16), (13, 9)] {
+            for max_levels in [None, Some(1), Some(2)] {
+                for _ in 0..4 {
+                    let mut v: Vec<f32> = (0..w * h * 4).map(|_| rng.unit() as f32).collect();
+                    let i = (rng.next_u64() % v.len() as u64) as usize;
+                    v[i] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY][i % 3];
+                    let tex = Texture::from_f32(w, h, f, v).unwrap();
+                    let opts = MipOptions {
+                        max_levels,
+                        ..MipOptions::with_filter(filter)
+                    };
+                    match mip::build(tex.clone(), &opts) {
+                        Err(parvo::Error::NonFinite { x, y, channel, .. }) => {
+                            assert_eq!(((y * w + x) * 4 + channel as u32) as usize, i);
+                        }
+                        other => panic!(
+                            "{filter} {w}x{h} {max_levels:?}: {:?}",
+                            other.map(|c| c.len())
+                        ),
+                    }
+                    assert!(mip::build_reduced_levels(&tex, &opts).is_err());
+                }
+            }
+        }
+    }
+}

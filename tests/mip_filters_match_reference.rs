@@ -137,3 +137,45 @@ fn level_sizes_follow_the_spec() {
         }
     }
 }
+
+#[test]
+fn opaque_straight_alpha_takes_the_unweighted_path_and_matches_reference() {
+    // Constant alpha (opaque, and a constant 0.5) lets the filters skip
+    // alpha weighting; the result must still equal the weighted reference.
+    let mut rng = Rng(0x5eed_0005);
+    for filter in MipFilter::ALL {
+        for (ty, alpha) in [
+            (ChannelType::F32, 1.0f64),
+            (ChannelType::F32, 0.5),
+            (ChannelType::U8, 1.0),
+        ] {
+            for &(w, h) in &[(64u32, 32u32), (12, 19)] {
+                let f = Format::new(4, ty, ColorSpace::Linear);
+                let tex = random_texture(&mut rng, w, h, f);
+                let texels = match tex.texels().clone() {
+                    parvo::Texels::F32(mut v) => {
+                        v.iter_mut()
+                            .skip(3)
+                            .step_by(4)
+                            .for_each(|a| *a = alpha as f32);
+                        parvo::Texels::F32(v)
+                    }
+                    parvo::Texels::U8(mut v) => {
+                        v.iter_mut()
+                            .skip(3)
+                            .step_by(4)
+                            .for_each(|a| *a = (alpha * 255.0) as u8);
+                        parvo::Texels::U8(v)
+                    }
+                    _ => unreachable!(),
+                };
+                let tex = parvo::Texture::from_texels(w, h, f, texels).unwrap();
+                check_chain(
+                    tex,
+                    &MipOptions::with_filter(filter),
+                    &format!("opaque {filter} {ty} {w}x{h}"),
+                );
+            }
+        }
+    }
+}

@@ -360,7 +360,21 @@ pub fn box_f32(src: &[f32], sw: usize, fmt: Format, straight: Option<usize>) -> 
                     (3, _) => row_f32::<3>(r0, r1, d),
                     (2, None) => row_f32::<2>(r0, r1, d),
                     (1, _) => row_f32::<1>(r0, r1, d),
-                    (_, Some(a)) => row_f32_straight(r0, r1, d, ch, a),
+                    // Plain average first (it brings both rows into cache),
+                    // then redo the row with alpha weighting only if its
+                    // alphas differ.
+                    (4, Some(a)) => {
+                        row_f32::<4>(r0, r1, d);
+                        if !f32_alpha_constant::<4>(r0, r1, a) {
+                            row_f32_straight(r0, r1, d, 4, a);
+                        }
+                    }
+                    (2, Some(a)) => {
+                        row_f32::<2>(r0, r1, d);
+                        if !f32_alpha_constant::<2>(r0, r1, a) {
+                            row_f32_straight(r0, r1, d, 2, a);
+                        }
+                    }
                     _ => unreachable!("channel count is validated to 1..=4"),
                 }
             }
@@ -376,12 +390,33 @@ fn row_f32<const CH: usize>(r0: &[f32], r1: &[f32], dst: &mut [f32]) {
         .zip(r1.chunks_exact(2 * CH))
     {
         for c in 0..CH {
-            // f64: the sum of four f32 cannot overflow (f32::MAX averages to
-            // itself) and subnormals keep every bit; one rounding at the end.
-            let s = (a[c] as f64 + a[CH + c] as f64) + (b[c] as f64 + b[CH + c] as f64);
-            d[c] = (0.25 * s) as f32;
+            d[c] = 0.25 * ((a[c] + a[CH + c]) + (b[c] + b[CH + c]));
         }
     }
+    // The f32 sum overflows only for values near f32::MAX; redo those few
+    // texels in f64 so a finite input never averages to infinity.
+    let any_inf = dst.iter().fold(false, |acc, v| acc | v.is_infinite());
+    if any_inf {
+        for (x, d) in dst.chunks_exact_mut(CH).enumerate() {
+            for c in 0..CH {
+                if d[c].is_infinite() {
+                    let i = 2 * x * CH + c;
+                    let s = (r0[i] as f64 + r0[i + CH] as f64) + (r1[i] as f64 + r1[i + CH] as f64);
+                    d[c] = (0.25 * s) as f32;
+                }
+            }
+        }
+    }
+}
+
+/// Every alpha of both rows equal (bitwise): weighting would cancel.
+fn f32_alpha_constant<const CH: usize>(r0: &[f32], r1: &[f32], a: usize) -> bool {
+    let first = r0[a].to_bits();
+    let diff = |row: &[f32]| {
+        row.chunks_exact(CH)
+            .fold(0u32, |acc, t| acc | (t[a].to_bits() ^ first))
+    };
+    (diff(r0) | diff(r1)) == 0
 }
 
 fn row_f32_straight(r0: &[f32], r1: &[f32], dst: &mut [f32], ch: usize, a: usize) {
@@ -403,7 +438,9 @@ fn row_f32_straight(r0: &[f32], r1: &[f32], dst: &mut [f32], ch: usize, a: usize
             } as f32;
         }
         if 0.25 * sa <= 1e-7 {
-            d[a] = d[a].max(0.0);
+            if d[a] < 0.0 && d[a].is_finite() {
+                d[a] = 0.0;
+            }
         }
     }
 }

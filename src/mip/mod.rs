@@ -317,7 +317,7 @@ pub fn build_reduced_levels(base: &Texture, options: &MipOptions) -> Result<Vec<
             "build_reduced_levels cannot repair level 0: use build with this NaN policy".into(),
         ));
     }
-    nan::check(base)?;
+    let deferred = defer_nan_check(base, options)?;
     let sizes = level_sizes(
         base.width(),
         base.height(),
@@ -329,6 +329,9 @@ pub fn build_reduced_levels(base: &Texture, options: &MipOptions) -> Result<Vec<
     for &(w, h) in &sizes[1..] {
         let prev = levels.last().unwrap_or(base);
         let next = reduce_post(prev, w, h, options, coverage0)?;
+        if deferred && levels.is_empty() {
+            nan::check_via_reduced(base, &next)?;
+        }
         levels.push(next);
     }
     Ok(levels)
@@ -371,7 +374,10 @@ pub fn build_with_progress(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MipChain> {
     validate(&base, options)?;
-    nan::apply(&mut base, options.nan_policy)?;
+    let deferred = defer_nan_check(&base, options)?;
+    if !deferred {
+        nan::apply(&mut base, options.nan_policy)?;
+    }
     let sizes = level_sizes(
         base.width(),
         base.height(),
@@ -392,6 +398,9 @@ pub fn build_with_progress(
     for &(w, h) in &sizes[1..] {
         let prev = levels.last().expect("level 0 is present");
         let next = reduce_post(prev, w, h, options, coverage0)?;
+        if deferred && levels.len() == 1 {
+            nan::check_via_reduced(&levels[0], &next)?;
+        }
         levels.push(next);
         p.levels_done += 1;
         p.texels_done += w as u64 * h as u64;
@@ -401,6 +410,31 @@ pub fn build_with_progress(
         levels,
         options: *options,
     })
+}
+
+/// Under [`NanPolicy::Error`] the full scan of level 0 is deferred when a
+/// reduction follows: every texel of level 0 has a non-zero weight in
+/// level 1 and NaN/Inf propagate through the filters, so a clean level 1
+/// proves a clean level 0 and the scan (a whole extra pass over the
+/// largest level) is only run to name the bad texel. Returns whether the
+/// check was deferred; a single-level chain is checked here.
+/// Post-processing that could hide a NaN (normal renormalisation, alpha
+/// scaling) also turns the deferral off.
+fn defer_nan_check(base: &Texture, options: &MipOptions) -> Result<bool> {
+    if options.nan_policy != NanPolicy::Error || !base.channel_type().is_float() {
+        return Ok(false);
+    }
+    let levels = level_count(
+        base.width(),
+        base.height(),
+        options.rounding,
+        options.max_levels,
+    );
+    if levels < 2 || options.normal_map || options.alpha_coverage.is_some() {
+        nan::check(base)?;
+        return Ok(false);
+    }
+    Ok(true)
 }
 
 fn validate(base: &Texture, options: &MipOptions) -> Result<()> {

@@ -47,10 +47,26 @@ pub fn reduce_linear(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Vec
     let wy = weights::axis(options.filter, src.height(), h, options.wrap.v);
     let data = linear_source(src);
     let data: &[f32] = &data;
+    // With one alpha everywhere (the opaque case) weighting by alpha
+    // cancels out exactly, so the cheaper unweighted filter is the same.
     let straight = match fmt.alpha_channel() {
-        Some(a) if fmt.alpha == AlphaMode::Straight => Some(a),
+        Some(a) if fmt.alpha == AlphaMode::Straight && !alpha_is_constant(data, ch, a) => Some(a),
         _ => None,
     };
+    // Straight alpha: filter colour·alpha (premultiplied once, here) and
+    // divide afterwards; `data` stays for the unweighted fallback.
+    let premultiplied: Option<Vec<f32>> = straight.map(|a| {
+        let mut pm = data.to_vec();
+        pm.par_chunks_mut(ch * 4096).for_each(|c| {
+            for t in c.chunks_exact_mut(ch) {
+                for k in (0..ch).filter(|&k| k != a) {
+                    t[k] *= t[a];
+                }
+            }
+        });
+        pm
+    });
+    let filtered: &[f32] = premultiplied.as_deref().unwrap_or(data);
     let row_len = w as usize * ch;
     let mut out = vec![0f32; row_len * h as usize];
     out.par_chunks_mut(row_len).enumerate().for_each_init(
@@ -58,21 +74,9 @@ pub fn reduce_linear(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Vec
         |tmp, (y, dst)| {
             tmp.fill(0.0);
             for (j, wgt) in wy.of(y) {
-                let row = &data[j as usize * sw * ch..][..sw * ch];
-                match straight {
-                    None => {
-                        for (t, &s) in tmp.iter_mut().zip(row) {
-                            *t += wgt * s;
-                        }
-                    }
-                    Some(a) => {
-                        for (t, s) in tmp.chunks_exact_mut(ch).zip(row.chunks_exact(ch)) {
-                            let wa = wgt * s[a];
-                            for c in 0..ch {
-                                t[c] += if c == a { wgt * s[a] } else { wa * s[c] };
-                            }
-                        }
-                    }
+                let row = &filtered[j as usize * sw * ch..][..sw * ch];
+                for (t, &s) in tmp.iter_mut().zip(row) {
+                    *t += wgt * s;
                 }
             }
             horizontal(tmp, dst, &wx, ch);
@@ -88,13 +92,26 @@ pub fn reduce_linear(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Vec
                         for c in (0..ch).filter(|&c| c != a) {
                             t[c] = plain[c];
                         }
-                        t[a] = alpha.max(0.0);
+                        // Negative overshoot becomes 0; NaN and -Inf stay visible.
+                        t[a] = if alpha < 0.0 && alpha.is_finite() {
+                            0.0
+                        } else {
+                            alpha
+                        };
                     }
                 }
             }
         },
     );
     out
+}
+
+fn alpha_is_constant(data: &[f32], ch: usize, a: usize) -> bool {
+    let first = data[a];
+    data.par_chunks(ch * 4096).all(|c| {
+        c.chunks_exact(ch)
+            .all(|t| t[a].to_bits() == first.to_bits())
+    })
 }
 
 fn horizontal(tmp: &[f32], dst: &mut [f32], wx: &AxisWeights, ch: usize) {
