@@ -398,11 +398,11 @@ fn row_f32<const CH: usize>(r0: &[f32], r1: &[f32], dst: &mut [f32]) {
     let any_inf = dst.iter().fold(false, |acc, v| acc | v.is_infinite());
     if any_inf {
         for (x, d) in dst.chunks_exact_mut(CH).enumerate() {
-            for c in 0..CH {
-                if d[c].is_infinite() {
+            for (c, v) in d.iter_mut().enumerate() {
+                if v.is_infinite() {
                     let i = 2 * x * CH + c;
                     let s = (r0[i] as f64 + r0[i + CH] as f64) + (r1[i] as f64 + r1[i + CH] as f64);
-                    d[c] = (0.25 * s) as f32;
+                    *v = (0.25 * s) as f32;
                 }
             }
         }
@@ -437,10 +437,8 @@ fn row_f32_straight(r0: &[f32], r1: &[f32], dst: &mut [f32], ch: usize, a: usize
                 0.25 * ((v[0] + v[1]) + (v[2] + v[3]))
             } as f32;
         }
-        if 0.25 * sa <= 1e-7 {
-            if d[a] < 0.0 && d[a].is_finite() {
-                d[a] = 0.0;
-            }
+        if 0.25 * sa <= 1e-7 && d[a] < 0.0 && d[a].is_finite() {
+            d[a] = 0.0;
         }
     }
 }
