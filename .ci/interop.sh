@@ -7,8 +7,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV_BIN="$(scripts/setup-interop.sh)"
-cargo build --quiet --bin parvo
-PARVO="$PWD/target/debug/parvo"
+cargo build --release --quiet --bin parvo
+PARVO="$PWD/target/release/parvo"
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
 echo "interop: OpenImageIO $("$VENV_BIN/oiiotool" --version)"
