@@ -17,35 +17,16 @@ const WRAPS: [WrapMode; 5] = [
 fn constant(w: u32, h: u32, f: Format, rng: &mut Rng) -> Texture {
     let one = random_texture(rng, 1, 1, f);
     let ch = f.channels as usize;
+    let n = w as usize * h as usize * ch;
+    // Repeat the one random texel n / ch times, whatever the storage type.
+    fn tile<T: Copy>(v: &[T], n: usize) -> Vec<T> {
+        v.iter().cycle().take(n).copied().collect()
+    }
     let texels = match one.texels() {
-        Texels::U8(v) => Texels::U8(
-            v.iter()
-                .cycle()
-                .take(w as usize * h as usize * ch)
-                .copied()
-                .collect(),
-        ),
-        Texels::U16(v) => Texels::U16(
-            v.iter()
-                .cycle()
-                .take(w as usize * h as usize * ch)
-                .copied()
-                .collect(),
-        ),
-        Texels::F16(v) => Texels::F16(
-            v.iter()
-                .cycle()
-                .take(w as usize * h as usize * ch)
-                .copied()
-                .collect(),
-        ),
-        Texels::F32(v) => Texels::F32(
-            v.iter()
-                .cycle()
-                .take(w as usize * h as usize * ch)
-                .copied()
-                .collect(),
-        ),
+        Texels::U8(v) => Texels::U8(tile(v, n)),
+        Texels::U16(v) => Texels::U16(tile(v, n)),
+        Texels::F16(v) => Texels::F16(tile(v, n)),
+        Texels::F32(v) => Texels::F32(tile(v, n)),
     };
     Texture::from_texels(w, h, f, texels).unwrap()
 }

@@ -58,12 +58,8 @@ impl FromStr for NanPolicy {
 pub fn check(tex: &Texture) -> Result<()> {
     let (w, ch) = (tex.width() as usize, tex.channels());
     let at = match tex.texels() {
-        Texels::F32(v) => {
-            first_non_finite(v, |x| x.to_bits() & 0x7f80_0000 == 0x7f80_0000).map(|i| (i, v[i]))
-        }
-        Texels::F16(v) => {
-            first_non_finite(v, |x| x.to_bits() & 0x7c00 == 0x7c00).map(|i| (i, v[i].to_f32()))
-        }
+        Texels::F32(v) => first_non_finite(v, bad_f32).map(|i| (i, v[i])),
+        Texels::F16(v) => first_non_finite(v, bad_f16).map(|i| (i, v[i].to_f32())),
         Texels::U8(_) | Texels::U16(_) => None,
     };
     match at {
@@ -84,13 +80,21 @@ pub fn check(tex: &Texture) -> Result<()> {
 /// negative-lobe kernels near the top of the f32 range — passes.)
 pub fn check_via_reduced(level0: &Texture, reduced: &Texture) -> Result<()> {
     let dirty = match reduced.texels() {
-        Texels::F32(v) => {
-            first_non_finite(v, |x| x.to_bits() & 0x7f80_0000 == 0x7f80_0000).is_some()
-        }
-        Texels::F16(v) => first_non_finite(v, |x| x.to_bits() & 0x7c00 == 0x7c00).is_some(),
+        Texels::F32(v) => first_non_finite(v, bad_f32).is_some(),
+        Texels::F16(v) => first_non_finite(v, bad_f16).is_some(),
         Texels::U8(_) | Texels::U16(_) => false,
     };
     if dirty { check(level0) } else { Ok(()) }
+}
+
+/// NaN or ±Inf (all exponent bits set), as a bit test that vectorises.
+fn bad_f32(x: &f32) -> bool {
+    x.to_bits() & 0x7f80_0000 == 0x7f80_0000
+}
+
+/// The same test for half floats.
+fn bad_f16(x: &half::f16) -> bool {
+    x.to_bits() & 0x7c00 == 0x7c00
 }
 
 /// Index of the first value for which `bad` holds. Scans in parallel
@@ -111,12 +115,12 @@ pub fn apply(tex: &mut Texture, policy: NanPolicy) -> Result<()> {
     let (w, h, ch) = (tex.width() as usize, tex.height() as usize, tex.channels());
     match tex.texels_mut() {
         Texels::F32(v) => {
-            if let Some(i) = first_non_finite(v, |x| x.to_bits() & 0x7f80_0000 == 0x7f80_0000) {
+            if let Some(i) = first_non_finite(v, bad_f32) {
                 fix(v, i, w, h, ch, policy)?;
             }
         }
         Texels::F16(v) => {
-            if let Some(i) = first_non_finite(v, |x| x.to_bits() & 0x7c00 == 0x7c00) {
+            if let Some(i) = first_non_finite(v, bad_f16) {
                 let mut f = v.to_f32_vec();
                 fix(&mut f, i, w, h, ch, policy)?;
                 v.convert_from_f32_slice(&f);
