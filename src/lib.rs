@@ -52,6 +52,7 @@
 pub mod builtin;
 pub mod error;
 pub mod io;
+mod mem;
 pub mod mip;
 pub mod sample;
 pub mod sat;

@@ -6,8 +6,8 @@
 //!   which vectorises), the horizontal pairs are summed from it.
 //! - u8, sRGB: colour channels through a 256-entry decode table in 2^-24
 //!   fixed point, summed in u32, and encoded by comparing against the exact
-//!   sRGB decision thresholds (a 64 Ki-bucket index gives the candidate
-//!   code, one comparison settles it). No `powf` per texel, and the result
+//!   sRGB decision thresholds (a 4 Ki-bucket index, small enough for the
+//!   L1 cache, gives the candidate code; one comparison settles it). No `powf` per texel, and the result
 //!   is the correctly rounded code except within ~1e-3 of a code of a tie.
 //! - f32, linear: one fused pass reading the 2×2 block, no decode copy.
 //!
@@ -33,8 +33,15 @@ use crate::texture::Texture;
 const TASK_BYTES: usize = 64 * 1024;
 
 /// Reduce with a fast path if one applies; `Ok(None)` means "use the plain
-/// path".
-pub fn try_reduce(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result<Option<Texture>> {
+/// path". The flag is true when the kernel saw every output value finite
+/// (only the f32 RGBA kernel tracks it; it lets the deferred NaN check
+/// skip its scan of level 1).
+pub fn try_reduce(
+    src: &Texture,
+    w: u32,
+    h: u32,
+    options: &MipOptions,
+) -> Result<Option<(Texture, bool)>> {
     let (sw, sh) = (src.width(), src.height());
     if options.filter != MipFilter::Box || sw != 2 * w || sh != 2 * h {
         return Ok(None);
@@ -43,17 +50,22 @@ pub fn try_reduce(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result
     let straight = fmt
         .alpha_channel()
         .filter(|_| fmt.alpha == AlphaMode::Straight);
-    let texels = match (src.texels(), fmt.color_space) {
-        (Texels::U8(s), ColorSpace::Linear) => {
-            Texels::U8(box_u8(s, sw as usize, fmt, straight, false))
+    let (texels, finite) = match (src.texels(), fmt.color_space) {
+        (Texels::U8(s), ColorSpace::Linear) => (
+            Texels::U8(box_u8(s, sw as usize, fmt, straight, false)),
+            false,
+        ),
+        (Texels::U8(s), ColorSpace::Srgb) => (
+            Texels::U8(box_u8(s, sw as usize, fmt, straight, true)),
+            false,
+        ),
+        (Texels::F32(s), ColorSpace::Linear) => {
+            let (v, finite) = box_f32(s, sw as usize, fmt, straight);
+            (Texels::F32(v), finite)
         }
-        (Texels::U8(s), ColorSpace::Srgb) => {
-            Texels::U8(box_u8(s, sw as usize, fmt, straight, true))
-        }
-        (Texels::F32(s), ColorSpace::Linear) => Texels::F32(box_f32(s, sw as usize, fmt, straight)),
         _ => return Ok(None),
     };
-    Texture::from_texels(w, h, fmt, texels).map(Some)
+    Texture::from_texels(w, h, fmt, texels).map(|t| Some((t, finite)))
 }
 
 fn rows_per_task(row_bytes: usize) -> usize {
@@ -65,7 +77,7 @@ pub fn box_u8(src: &[u8], sw: usize, fmt: Format, straight: Option<usize>, srgb:
     let ch = fmt.channels as usize;
     let (w, h) = (sw / 2, src.len() / (sw * ch) / 2);
     let row = w * ch;
-    let mut dst = vec![0u8; row * h];
+    let mut dst: Vec<u8> = crate::mem::zeroed(row * h);
     let per = rows_per_task(row);
     let tables = srgb.then(fixed_tables);
     dst.par_chunks_mut(row * per).enumerate().for_each_init(
@@ -161,6 +173,75 @@ mod simd {
         }
     }
 
+    /// 2×2 averages of RGBA f32 texel pairs (`a`, `b` are two rows of
+    /// `2 · d.len()` texels). Returns whether any alpha differs from the
+    /// first alpha of `a`, and the largest `bits & 0x7fff_ffff` of an output
+    /// value (≥ `0x7f80_0000` means a non-finite output). On x86_64 each
+    /// texel is one SSE register (SSE2 is baseline, so the intrinsics are
+    /// safe to call); LLVM's own vectoriser shuffles lanes across texels
+    /// instead and is about twice as slow.
+    #[inline]
+    pub fn rgba_f32_box(a: &[[f32; 4]], b: &[[f32; 4]], d: &mut [[f32; 4]]) -> (bool, u32) {
+        #[cfg(target_arch = "x86_64")]
+        #[allow(unsafe_code)]
+        // SAFETY: `rgba_f32_box_sse2` only requires SSE2, which every x86_64
+        // CPU has (it is in the target's baseline feature set).
+        unsafe {
+            rgba_f32_box_sse2(a, b, d)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            let first = a[0][3].to_bits();
+            let (mut diff, mut top) = (0u32, 0u32);
+            for ((o, p), q) in d.iter_mut().zip(a.chunks_exact(2)).zip(b.chunks_exact(2)) {
+                for c in 0..4 {
+                    o[c] = 0.25 * ((p[0][c] + p[1][c]) + (q[0][c] + q[1][c]));
+                    top = top.max(o[c].to_bits() & 0x7fff_ffff);
+                }
+                diff |= [p[0][3], p[1][3], q[0][3], q[1][3]]
+                    .iter()
+                    .fold(0, |acc, v| acc | (v.to_bits() ^ first));
+            }
+            (diff != 0, top)
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "sse2")]
+    fn rgba_f32_box_sse2(a: &[[f32; 4]], b: &[[f32; 4]], d: &mut [[f32; 4]]) -> (bool, u32) {
+        {
+            use std::arch::x86_64::*;
+            let ld = |t: &[f32; 4]| -> __m128 { bytemuck::cast(*t) };
+            let quarter = _mm_set1_ps(0.25);
+            let first = _mm_set1_epi32(a[0][3].to_bits() as i32);
+            let abs = _mm_set1_epi32(0x7fff_ffff);
+            let (mut diff, mut top) = (_mm_setzero_si128(), _mm_setzero_si128());
+            for ((o, p), q) in d.iter_mut().zip(a.chunks_exact(2)).zip(b.chunks_exact(2)) {
+                let (p0, p1, q0, q1) = (ld(&p[0]), ld(&p[1]), ld(&q[0]), ld(&q[1]));
+                let s = _mm_mul_ps(quarter, _mm_add_ps(_mm_add_ps(p0, p1), _mm_add_ps(q0, q1)));
+                *o = bytemuck::cast(s);
+                let x = _mm_or_si128(
+                    _mm_or_si128(
+                        _mm_xor_si128(_mm_castps_si128(p0), first),
+                        _mm_xor_si128(_mm_castps_si128(p1), first),
+                    ),
+                    _mm_or_si128(
+                        _mm_xor_si128(_mm_castps_si128(q0), first),
+                        _mm_xor_si128(_mm_castps_si128(q1), first),
+                    ),
+                );
+                diff = _mm_or_si128(diff, x);
+                // Magnitudes as integers: signed max is fine below 2^31.
+                let m = _mm_and_si128(_mm_castps_si128(s), abs);
+                let gt = _mm_cmpgt_epi32(m, top);
+                top = _mm_or_si128(_mm_and_si128(gt, m), _mm_andnot_si128(gt, top));
+            }
+            let diff: [u32; 4] = bytemuck::cast(diff);
+            let top: [u32; 4] = bytemuck::cast(top);
+            (diff[3] != 0, top.into_iter().max().unwrap_or(0))
+        }
+    }
+
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "sse2")]
     fn row_rgba8(r0: &[u8], r1: &[u8], tmp: &mut [u16], dst: &mut [u8]) -> bool {
@@ -218,10 +299,17 @@ mod simd {
 pub(crate) struct FixedSrgb {
     dec: [u32; 256],
     thr: [u32; 256],
-    bucket: Vec<u8>,
+    /// Indexed by `s >> BUCKET_SHIFT` masked to the table size (so no
+    /// bounds check); sums reach at most bucket 4096, the rest is padding.
+    bucket: Box<[u8; BUCKETS]>,
 }
 
-const BUCKET_SHIFT: u32 = 10;
+const BUCKETS: usize = 8192;
+
+/// Bucket width 2^14 units: below the smallest threshold spacing (20369
+/// units, in the linear segment near black), so a bucket holds at most one
+/// threshold; 4097 one-byte buckets stay in the L1 cache.
+const BUCKET_SHIFT: u32 = 14;
 
 fn fixed_tables() -> &'static FixedSrgb {
     static T: OnceLock<FixedSrgb> = OnceLock::new();
@@ -234,8 +322,7 @@ fn fixed_tables() -> &'static FixedSrgb {
         for (k, t) in thr.iter_mut().enumerate().take(255) {
             *t = (srgb::decode_f64((k as f64 + 0.5) / 255.0) * (1u64 << 26) as f64).ceil() as u32;
         }
-        let n = ((1u32 << 26) >> BUCKET_SHIFT) as usize + 1;
-        let mut bucket = vec![0u8; n];
+        let mut bucket = Box::new([0u8; BUCKETS]);
         let mut code = 0usize;
         for (b, slot) in bucket.iter_mut().enumerate() {
             let lo = (b as u32) << BUCKET_SHIFT;
@@ -251,12 +338,12 @@ fn fixed_tables() -> &'static FixedSrgb {
 impl FixedSrgb {
     /// Code of a sum of four decoded values (2^-26 units of linear light).
     ///
-    /// Thresholds are at least ~20000 units apart (the steepest part of
-    /// the curve, near 0) and buckets 1024 wide, so the bucket's code is at
-    /// most one below the answer: one comparison, no loop.
+    /// Thresholds are at least 20369 units apart (the steepest part of
+    /// the curve, near 0) and buckets 16384 wide, so the bucket's code is
+    /// at most one below the answer: one comparison, no loop.
     #[inline(always)]
     fn encode4(&self, s: u32) -> u8 {
-        let c = self.bucket[(s >> BUCKET_SHIFT) as usize];
+        let c = self.bucket[(s >> BUCKET_SHIFT) as usize & (BUCKETS - 1)];
         c + u8::from(s >= self.thr[c as usize])
     }
 }
@@ -266,7 +353,32 @@ fn row_u8_srgb(r0: &[u8], r1: &[u8], dst: &mut [u8], fmt: Format, t: &FixedSrgb)
         1 => row_u8_srgb_n::<1, 1>(r0, r1, dst, t),
         2 => row_u8_srgb_n::<2, 1>(r0, r1, dst, t),
         3 => row_u8_srgb_n::<3, 3>(r0, r1, dst, t),
-        _ => row_u8_srgb_n::<4, 3>(r0, r1, dst, t),
+        _ => row_rgba8_srgb(r0, r1, dst, t),
+    }
+}
+
+/// RGBA8 sRGB: one 8-byte load per row and texel pair, bytes taken out by
+/// shifts, one 4-byte store (fewer load slots than byte loads: the table
+/// look-ups are what the loop is bound by).
+#[inline(always)]
+fn row_rgba8_srgb(r0: &[u8], r1: &[u8], dst: &mut [u8], t: &FixedSrgb) {
+    let dec = &t.dec;
+    let word = |s: &[u8]| u64::from_le_bytes(s.try_into().expect("8 bytes"));
+    for ((d, a), b) in dst
+        .chunks_exact_mut(4)
+        .zip(r0.chunks_exact(8))
+        .zip(r1.chunks_exact(8))
+    {
+        let (a, b) = (word(a), word(b));
+        let byte = |v: u64, k: u32| (v >> (8 * k)) as u8 as usize;
+        let mut out = 0u32;
+        for c in 0..3 {
+            let s = dec[byte(a, c)] + dec[byte(a, c + 4)] + dec[byte(b, c)] + dec[byte(b, c + 4)];
+            out |= (t.encode4(s) as u32) << (8 * c);
+        }
+        let alpha = (a >> 24 & 0xFF) + (a >> 56) + (b >> 24 & 0xFF) + (b >> 56);
+        out |= (((alpha + 2) >> 2) as u32) << 24;
+        d.copy_from_slice(&out.to_le_bytes());
     }
 }
 
@@ -341,13 +453,17 @@ fn fix_straight_alpha_u8(
     }
 }
 
-/// 2×2 box of an even-sized linear f32 level, one fused pass.
-pub fn box_f32(src: &[f32], sw: usize, fmt: Format, straight: Option<usize>) -> Vec<f32> {
+/// 2×2 box of an even-sized linear f32 level, one fused pass. Returns the
+/// level and whether every output value is finite (tracked by the RGBA
+/// kernel only; `false` means "not known").
+pub fn box_f32(src: &[f32], sw: usize, fmt: Format, straight: Option<usize>) -> (Vec<f32>, bool) {
+    use std::sync::atomic::{AtomicBool, Ordering};
     let ch = fmt.channels as usize;
     let (w, h) = (sw / 2, src.len() / (sw * ch) / 2);
     let row = w * ch;
-    let mut dst = vec![0f32; row * h];
+    let mut dst: Vec<f32> = crate::mem::zeroed(row * h);
     let per = rows_per_task(row * 4);
+    let finite = AtomicBool::new(ch == 4);
     dst.par_chunks_mut(row * per)
         .enumerate()
         .for_each(|(task, out)| {
@@ -356,19 +472,22 @@ pub fn box_f32(src: &[f32], sw: usize, fmt: Format, straight: Option<usize>) -> 
                 let r0 = &src[2 * y * sw * ch..][..sw * ch];
                 let r1 = &src[(2 * y + 1) * sw * ch..][..sw * ch];
                 match (ch, straight) {
-                    (4, None) => row_f32::<4>(r0, r1, d),
+                    (4, _) => {
+                        let (alpha_differs, bad) = row_f32x4(r0, r1, d);
+                        // Alpha weighting changes nothing when every alpha
+                        // of both rows is the same (the opaque case).
+                        if let Some(a) = straight
+                            && alpha_differs
+                        {
+                            row_f32_straight(r0, r1, d, 4, a);
+                        }
+                        if bad && !all_finite(d) {
+                            finite.store(false, Ordering::Relaxed);
+                        }
+                    }
                     (3, _) => row_f32::<3>(r0, r1, d),
                     (2, None) => row_f32::<2>(r0, r1, d),
                     (1, _) => row_f32::<1>(r0, r1, d),
-                    // Plain average first (it brings both rows into cache),
-                    // then redo the row with alpha weighting only if its
-                    // alphas differ.
-                    (4, Some(a)) => {
-                        row_f32::<4>(r0, r1, d);
-                        if !f32_alpha_constant::<4>(r0, r1, a) {
-                            row_f32_straight(r0, r1, d, 4, a);
-                        }
-                    }
                     (2, Some(a)) => {
                         row_f32::<2>(r0, r1, d);
                         if !f32_alpha_constant::<2>(r0, r1, a) {
@@ -379,7 +498,28 @@ pub fn box_f32(src: &[f32], sw: usize, fmt: Format, straight: Option<usize>) -> 
                 }
             }
         });
-    dst
+    (dst, finite.into_inner())
+}
+
+fn all_finite(v: &[f32]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+/// The RGBA f32 row kernel: one pass that averages each 2×2 block (texels
+/// as `[f32; 4]`, so each block is three vector adds and a multiply),
+/// notes whether any alpha differs from the row's first alpha, and whether
+/// any output is non-finite. Sums that overflow to infinity from finite
+/// input are redone in f64. Returns `(alpha differs, non-finite seen)`.
+fn row_f32x4(r0: &[f32], r1: &[f32], dst: &mut [f32]) -> (bool, bool) {
+    let a4: &[[f32; 4]] = bytemuck::cast_slice(r0);
+    let b4: &[[f32; 4]] = bytemuck::cast_slice(r1);
+    let d4: &mut [[f32; 4]] = bytemuck::cast_slice_mut(dst);
+    let (diff, top) = simd::rgba_f32_box(a4, b4, d4);
+    let bad = top >= 0x7f80_0000;
+    if bad {
+        overflow_fixup::<4>(r0, r1, dst);
+    }
+    (diff, bad)
 }
 
 #[inline(always)]
@@ -393,17 +533,20 @@ fn row_f32<const CH: usize>(r0: &[f32], r1: &[f32], dst: &mut [f32]) {
             d[c] = 0.25 * ((a[c] + a[CH + c]) + (b[c] + b[CH + c]));
         }
     }
-    // The f32 sum overflows only for values near f32::MAX; redo those few
-    // texels in f64 so a finite input never averages to infinity.
-    let any_inf = dst.iter().fold(false, |acc, v| acc | v.is_infinite());
-    if any_inf {
-        for (x, d) in dst.chunks_exact_mut(CH).enumerate() {
-            for (c, v) in d.iter_mut().enumerate() {
-                if v.is_infinite() {
-                    let i = 2 * x * CH + c;
-                    let s = (r0[i] as f64 + r0[i + CH] as f64) + (r1[i] as f64 + r1[i + CH] as f64);
-                    *v = (0.25 * s) as f32;
-                }
+    if dst.iter().fold(false, |acc, v| acc | v.is_infinite()) {
+        overflow_fixup::<CH>(r0, r1, dst);
+    }
+}
+
+/// The f32 sum overflows only for values near f32::MAX; redo those few
+/// texels in f64 so a finite input never averages to infinity.
+fn overflow_fixup<const CH: usize>(r0: &[f32], r1: &[f32], dst: &mut [f32]) {
+    for (x, d) in dst.chunks_exact_mut(CH).enumerate() {
+        for (c, v) in d.iter_mut().enumerate() {
+            if v.is_infinite() {
+                let i = 2 * x * CH + c;
+                let s = (r0[i] as f64 + r0[i + CH] as f64) + (r1[i] as f64 + r1[i + CH] as f64);
+                *v = (0.25 * s) as f32;
             }
         }
     }

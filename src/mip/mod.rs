@@ -328,8 +328,8 @@ pub fn build_reduced_levels(base: &Texture, options: &MipOptions) -> Result<Vec<
     let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len() - 1);
     for &(w, h) in &sizes[1..] {
         let prev = levels.last().unwrap_or(base);
-        let next = reduce_post(prev, w, h, options, coverage0)?;
-        if deferred && levels.is_empty() {
+        let (next, finite) = reduce_post(prev, w, h, options, coverage0)?;
+        if deferred && levels.is_empty() && !finite {
             nan::check_via_reduced(base, &next)?;
         }
         levels.push(next);
@@ -350,15 +350,15 @@ fn reduce_post(
     h: u32,
     options: &MipOptions,
     coverage0: Option<f32>,
-) -> Result<Texture> {
-    let mut next = reduce(prev, w, h, options)?;
+) -> Result<(Texture, bool)> {
+    let (mut next, finite) = reduce_tracked(prev, w, h, options)?;
     if let (Some(r), Some(c0)) = (options.alpha_coverage, coverage0) {
         alpha::preserve_coverage(&mut next, r, c0);
     }
     if options.normal_map {
         normal::renormalize(&mut next);
     }
-    Ok(next)
+    Ok((next, finite))
 }
 
 /// Build the full chain of `base` (see the module docs).
@@ -397,8 +397,8 @@ pub fn build_with_progress(
     levels.push(base);
     for &(w, h) in &sizes[1..] {
         let prev = levels.last().expect("level 0 is present");
-        let next = reduce_post(prev, w, h, options, coverage0)?;
-        if deferred && levels.len() == 1 {
+        let (next, finite) = reduce_post(prev, w, h, options, coverage0)?;
+        if deferred && levels.len() == 1 && !finite {
             nan::check_via_reduced(&levels[0], &next)?;
         }
         levels.push(next);
@@ -471,10 +471,16 @@ fn validate(base: &Texture, options: &MipOptions) -> Result<()> {
 /// Reduce one level to `w × h` with the chosen filter (fast path if one
 /// applies, otherwise the separable path).
 pub fn reduce(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result<Texture> {
+    reduce_tracked(src, w, h, options).map(|(t, _)| t)
+}
+
+/// [`reduce`], and whether the kernel already proved every output value
+/// finite (then the deferred NaN check need not scan the result).
+fn reduce_tracked(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result<(Texture, bool)> {
     if options.fast_paths
         && let Some(t) = fast::try_reduce(src, w, h, options)?
     {
         return Ok(t);
     }
-    separable::reduce(src, w, h, options)
+    Ok((separable::reduce(src, w, h, options)?, false))
 }

@@ -68,7 +68,7 @@ pub fn reduce_linear(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Vec
     });
     let filtered: &[f32] = premultiplied.as_deref().unwrap_or(data);
     let row_len = w as usize * ch;
-    let mut out = vec![0f32; row_len * h as usize];
+    let mut out: Vec<f32> = crate::mem::zeroed(row_len * h as usize);
     out.par_chunks_mut(row_len).enumerate().for_each_init(
         || vec![0f32; sw * ch],
         |tmp, (y, dst)| {

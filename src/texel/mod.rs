@@ -280,10 +280,10 @@ impl Texels {
     /// `len` zero values of the given type.
     pub fn zeroed(ty: ChannelType, len: usize) -> Self {
         match ty {
-            ChannelType::U8 => Texels::U8(vec![0; len]),
-            ChannelType::U16 => Texels::U16(vec![0; len]),
-            ChannelType::F16 => Texels::F16(vec![f16::ZERO; len]),
-            ChannelType::F32 => Texels::F32(vec![0.0; len]),
+            ChannelType::U8 => Texels::U8(crate::mem::zeroed(len)),
+            ChannelType::U16 => Texels::U16(crate::mem::zeroed(len)),
+            ChannelType::F16 => Texels::F16(crate::mem::zeroed(len)),
+            ChannelType::F32 => Texels::F32(crate::mem::zeroed(len)),
         }
     }
 }
