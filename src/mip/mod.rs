@@ -482,5 +482,5 @@ fn reduce_tracked(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result
     {
         return Ok(t);
     }
-    Ok((separable::reduce(src, w, h, options)?, false))
+    separable::reduce(src, w, h, options)
 }

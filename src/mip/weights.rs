@@ -32,6 +32,15 @@ pub struct AxisWeights {
 }
 
 impl AxisWeights {
+    /// Per destination texel: the first source index when its `taps`
+    /// indices are consecutive (no padding, no wrap), else `None`.
+    pub fn contiguous_runs(&self) -> Vec<Option<u32>> {
+        self.index
+            .chunks_exact(self.taps)
+            .map(|idx| idx.windows(2).all(|p| p[1] == p[0] + 1).then_some(idx[0]))
+            .collect()
+    }
+
     /// (index, weight) pairs of destination texel `x`, zero weights skipped.
     pub fn of(&self, x: usize) -> impl Iterator<Item = (u32, f32)> + '_ {
         let r = x * self.taps..(x + 1) * self.taps;
