@@ -35,6 +35,9 @@
 //!   DDS and built-ins with decoder limits, and atomic saving of mip chains
 //!   as tiled mip-mapped EXR, KTX2, DDS or one PNG per level.
 //!
+//! Level buffers of 4 MiB and more are advised for transparent huge pages
+//! on Linux (one page fault per 2 MiB instead of 512; see `mem.rs`).
+//!
 //! The library never prints and never panics on bad input: errors are
 //! [`Error`] values, long builds report through a progress callback.
 //!

@@ -9,7 +9,10 @@
 //!   sRGB decision thresholds (a 4 Ki-bucket index, small enough for the
 //!   L1 cache, gives the candidate code; one comparison settles it). No `powf` per texel, and the result
 //!   is the correctly rounded code except within ~1e-3 of a code of a tie.
-//! - f32, linear: one fused pass reading the 2×2 block, no decode copy.
+//! - f32, linear: one fused pass reading the 2×2 block, no decode copy; for
+//!   RGBA each texel is one SSE register, and the same pass notes whether
+//!   any alpha differs and whether any output is non-finite (so neither
+//!   needs a pass of its own).
 //!
 //! Straight alpha: when the four alphas of a block differ, colour is the
 //! alpha-weighted average (integer arithmetic for u8, rounded to nearest);

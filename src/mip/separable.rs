@@ -2,12 +2,24 @@
 //! light, for every filter, channel type, size and wrap mode.
 //!
 //! Per destination row (in parallel): a vertical pass accumulates the rows
-//! the row's weights name into a scratch row (weighting colour by alpha for
-//! straight alpha), then a horizontal pass applies the column weights.
-//! Vertical first halves the work of the horizontal pass. With straight
-//! alpha the colour is divided back by the filtered alpha; where that alpha
-//! is zero (all contributing texels transparent) the colour falls back to
-//! the unweighted filter, so fully transparent regions keep their colour.
+//! the row's weights name into a scratch row, 32 values at a time held in
+//! registers across all taps (AVX2/FMA when the CPU has them, detected at
+//! run time; a portable version otherwise), then a horizontal pass applies
+//! the column weights, reading each destination texel's taps as one
+//! contiguous run except at wrapped edges. Vertical first halves the work
+//! of the horizontal pass.
+//!
+//! Straight alpha is decided per destination row: if every texel of the
+//! source rows it reads has the same alpha, weighting cancels and the
+//! plain filter runs; otherwise those rows are premultiplied into scratch,
+//! filtered, and the colour is divided back by the filtered alpha. Where
+//! that alpha is zero (all contributing texels transparent) the colour
+//! falls back to the unweighted filter, so fully transparent regions keep
+//! their colour.
+//!
+//! Each output row is checked for non-finite values while in cache; a
+//! level that comes out all finite proves its source finite, which lets the
+//! chain builder skip its deferred NaN scan.
 
 use std::borrow::Cow;
 use std::sync::OnceLock;
