@@ -83,8 +83,9 @@ pub use footprint::{Footprint, footprint, mip_linear, mip_nearest};
 pub use query::Query;
 pub use trace::{NoTrace, TexelCounter, TexelRead, TexelRecorder, TexelSink};
 
-use fetch::Addressing;
-use trilinear::Iso;
+use bilinear::{Filters, Lin, MagMin, Near};
+use fetch::{Addressing, Chain, Pixel, Store};
+use footprint::Lod;
 
 /// Filter names used on the command line and in reports (SPEC.md "Names
 /// used on the command line"). Each maps to a preset of
@@ -476,6 +477,7 @@ impl fmt::Display for SamplerOptions {
 enum Kernel {
     /// `Texel` with `max_aniso == 1`: η = 1, one probe, λ without roots.
     Isotropic,
+    /// `Texel` with `max_aniso > 1`: footprint assembly.
     Texel,
     Ewa,
     Supersample,
@@ -485,23 +487,28 @@ enum Kernel {
 
 /// A texture ready to be sampled with one set of options.
 ///
-/// Building it decodes the chain to linear RGBA `f32` once
-/// ([`LinearChain`]); [`Sampler::from_linear`] shares a decoded chain
-/// between samplers. Lookups take `&self` and are safe to run from many
-/// threads.
+/// Building it prepares the chain once ([`LinearChain`]: packed RGBA8 for
+/// 8-bit textures, linear RGBA `f32` otherwise); [`Sampler::from_linear`]
+/// shares a prepared chain between samplers. Lookups take `&self` and are
+/// safe to run from many threads.
+///
+/// Every lookup goes through one dispatch on the storage, the filter and
+/// the mip mode, made once per slice of queries (once per call for
+/// [`Sampler::sample`]); the loop inside is compiled for that combination
+/// alone.
 #[derive(Clone, Debug)]
 pub struct Sampler {
     chain: Arc<LinearChain>,
     options: SamplerOptions,
     kernel: Kernel,
     addr: Addressing,
-    iso: Iso,
+    lod: Lod,
     sat: Option<Arc<SatSampler>>,
 }
 
 impl Sampler {
-    /// Decode `chain` and check `options` (an [`Error::InvalidOption`] for
-    /// out-of-range values and for the `sat` filter, which needs a
+    /// Prepare `chain` and check `options` (an [`Error::InvalidOption`]
+    /// for out-of-range values and for the `sat` filter, which needs a
     /// summed-area table).
     ///
     /// For `sat` the summed-area table of level 0 is built here (the
@@ -526,7 +533,7 @@ impl Sampler {
         Ok(s)
     }
 
-    /// A sampler over an already decoded chain.
+    /// A sampler over an already prepared chain.
     /// The `sat` filter needs the stored level 0 and is refused here: use
     /// [`Sampler::new`].
     pub fn from_linear(chain: Arc<LinearChain>, options: SamplerOptions) -> Result<Self> {
@@ -543,6 +550,8 @@ impl Sampler {
             Method::Sat if have_sat => Kernel::Sat,
             Method::Sat => return Err(sat_unavailable()),
         };
+        let (wf, hf) = chain.size0();
+        let lod = Lod::new(&options, wf, hf, chain.len());
         Ok(Sampler {
             chain,
             options,
@@ -551,11 +560,7 @@ impl Sampler {
                 wrap: options.wrap,
                 border: options.border,
             },
-            iso: Iso {
-                mag: options.mag,
-                min: options.min,
-                mip: options.mip,
-            },
+            lod,
             sat: None,
         })
     }
@@ -565,15 +570,14 @@ impl Sampler {
         &self.options
     }
 
-    /// The decoded chain.
+    /// The prepared chain.
     pub fn chain(&self) -> &Arc<LinearChain> {
         &self.chain
     }
 
     /// LOD and anisotropy of `q` under these options.
     pub fn footprint(&self, q: &Query) -> Footprint {
-        let l = &self.chain.levels[0];
-        footprint(q, l.w, l.h, &self.options)
+        footprint::footprint_f64(q, self.lod.wf, self.lod.hf, &self.options)
     }
 
     /// Filtered linear RGBA colour at `q`.
@@ -585,55 +589,108 @@ impl Sampler {
     /// [`Sampler::sample`], reporting every texel read to `sink`.
     #[inline]
     pub fn sample_traced<S: TexelSink>(&self, q: &Query, sink: &mut S) -> [f32; 4] {
-        let levels = &self.chain.levels[..];
-        let u = coord(q.u);
-        let v = coord(q.v);
+        let mut out = [[0.0; 4]];
+        self.run(std::slice::from_ref(q), &mut out, sink);
+        out[0]
+    }
+
+    /// Sample `queries` into `out` (same length) in order, reporting to
+    /// `sink`: the one dispatch point of every lookup.
+    pub(crate) fn run<S: TexelSink>(&self, queries: &[Query], out: &mut [[f32; 4]], sink: &mut S) {
+        match &self.chain.store {
+            Store::Rgba8(c) => self.run_on(c, queries, out, sink),
+            Store::F32(c) => self.run_on(c, queries, out, sink),
+        }
+    }
+
+    fn run_on<P: Pixel, S: TexelSink>(
+        &self,
+        c: &Chain<P>,
+        queries: &[Query],
+        out: &mut [[f32; 4]],
+        sink: &mut S,
+    ) {
+        let (a, lod, o) = (&self.addr, &self.lod, &self.options);
         match self.kernel {
-            Kernel::Isotropic => {
-                let l = &levels[0];
-                let lambda = footprint::isotropic_lambda(q, l.wf, l.hf, &self.options);
-                trilinear::isotropic(levels, self.iso, &self.addr, u, v, lambda, sink)
-            }
-            Kernel::Texel => {
-                let l = &levels[0];
-                let fp = footprint(q, l.w, l.h, &self.options);
-                aniso::anisotropic(levels, self.iso, &self.addr, u, v, &fp, sink)
-            }
-            Kernel::Ewa => {
-                let (dx, dy) = footprint::derivatives(q, levels[0].wf, levels[0].hf);
-                ewa::ewa(
-                    levels,
-                    &self.addr,
-                    self.options.mip,
-                    self.options.max_aniso,
-                    &self.options,
-                    u,
-                    v,
-                    dx,
-                    dy,
-                    sink,
-                )
-            }
+            Kernel::Isotropic => self.run_filters::<P, S, false>(c, queries, out, sink),
+            Kernel::Texel => self.run_filters::<P, S, true>(c, queries, out, sink),
+            Kernel::Ewa => each(queries, out, |q| ewa::ewa(c, a, lod, o, q, sink)),
+            Kernel::Supersample => each(queries, out, |q| {
+                supersample::supersample(c, a, lod, o, q, sink)
+            }),
             // The table answers from four corner entries per rectangle, not
             // from texels, so nothing is reported to the sink.
-            Kernel::Sat => match &self.sat {
+            Kernel::Sat => each(queries, out, |q| match &self.sat {
                 Some(t) => t.sample(q.u, q.v, q.dudx, q.dvdx, q.dudy, q.dvdy),
                 None => [0.0; 4],
-            },
-            Kernel::Supersample => {
-                let (dx, dy) = footprint::derivatives(q, levels[0].wf, levels[0].hf);
-                supersample::supersample(
-                    levels,
-                    &self.addr,
-                    self.options.supersample,
-                    u,
-                    v,
-                    dx,
-                    dy,
-                    sink,
-                )
+            }),
+        }
+    }
+
+    fn run_filters<P: Pixel, S: TexelSink, const ANISO: bool>(
+        &self,
+        c: &Chain<P>,
+        queries: &[Query],
+        out: &mut [[f32; 4]],
+        sink: &mut S,
+    ) {
+        use TexelFilter::{Linear, Nearest};
+        match (self.options.mag, self.options.min) {
+            (Nearest, Nearest) => self.run_mip::<P, S, Near, ANISO>(c, Near, queries, out, sink),
+            (Linear, Linear) => self.run_mip::<P, S, Lin, ANISO>(c, Lin, queries, out, sink),
+            (mag, min) => {
+                let f = MagMin { mag, min };
+                self.run_mip::<P, S, MagMin, ANISO>(c, f, queries, out, sink)
             }
         }
+    }
+
+    fn run_mip<P: Pixel, S: TexelSink, F: Filters, const ANISO: bool>(
+        &self,
+        c: &Chain<P>,
+        f: F,
+        queries: &[Query],
+        out: &mut [[f32; 4]],
+        sink: &mut S,
+    ) {
+        use trilinear::{MIP_LINEAR, MIP_NEAREST, MIP_NONE};
+        match self.options.mip {
+            MipMode::None => self.run_texel::<P, S, F, MIP_NONE, ANISO>(c, f, queries, out, sink),
+            MipMode::Nearest => {
+                self.run_texel::<P, S, F, MIP_NEAREST, ANISO>(c, f, queries, out, sink)
+            }
+            MipMode::Linear => {
+                self.run_texel::<P, S, F, MIP_LINEAR, ANISO>(c, f, queries, out, sink)
+            }
+        }
+    }
+
+    fn run_texel<P: Pixel, S: TexelSink, F: Filters, const MIP: u8, const ANISO: bool>(
+        &self,
+        c: &Chain<P>,
+        f: F,
+        queries: &[Query],
+        out: &mut [[f32; 4]],
+        sink: &mut S,
+    ) {
+        let (a, lod, o) = (&self.addr, &self.lod, &self.options);
+        if ANISO {
+            each(queries, out, |q| {
+                aniso::anisotropic::<P, S, F, MIP>(c, f, lod, o, a, q, sink)
+            })
+        } else {
+            each(queries, out, |q| {
+                trilinear::isotropic::<P, S, F, MIP>(c, f, lod, o, a, q, sink)
+            })
+        }
+    }
+}
+
+/// `out[i] = f(&queries[i])`.
+#[inline(always)]
+fn each(queries: &[Query], out: &mut [[f32; 4]], mut f: impl FnMut(&Query) -> [f32; 4]) {
+    for (q, o) in queries.iter().zip(out.iter_mut()) {
+        *o = f(q);
     }
 }
 
@@ -643,10 +700,4 @@ fn sat_unavailable() -> Error {
          use Sampler::new"
             .into(),
     )
-}
-
-/// A query coordinate as `f64`, NaN read as 0.
-#[inline(always)]
-fn coord(x: f32) -> f64 {
-    if x.is_nan() { 0.0 } else { x as f64 }
 }
