@@ -97,20 +97,6 @@ impl Pixel for [u8; 4] {
             t[3][self[3] as usize],
         ]
     }
-
-    /// Per channel, with the four weights `(1−α)(1−β), α(1−β), (1−α)β,
-    /// αβ`: decoded values are in [0, 1], so the weighted sum cannot
-    /// overflow, and it is exact at α = β = 0 (weight 1 on t00).
-    #[inline(always)]
-    fn bilerp(t: [Self; 4], lut: &Lut8, al: f32, be: f32) -> [f32; 4] {
-        let (a0, b0) = (1.0 - al, 1.0 - be);
-        let w = [a0 * b0, al * b0, a0 * be, al * be];
-        let tab = &*lut.0;
-        std::array::from_fn(|c| {
-            let d = |k: usize| tab[c][t[k][c] as usize];
-            (d(0) * w[0] + d(1) * w[1]) + (d(2) * w[2] + d(3) * w[3])
-        })
-    }
 }
 
 /// One level, row-major.

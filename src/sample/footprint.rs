@@ -368,9 +368,11 @@ impl Lod {
     /// (see the type docs).
     #[inline(always)]
     pub fn plan_nearest(&self, q: &Query) -> Plan {
-        let y = self.y(q);
-        let bits = y.to_bits();
-        let c = ((bits >> 52) as i64 - 1023) + i64::from(bits & ((1u64 << 52) - 1) != 0);
+        // y ≥ 0, so its bits order like the value; adding the mantissa
+        // mask carries into the exponent exactly when y is not a power of
+        // two: the exponent field is then c + 1023.
+        let e = ((self.y(q).to_bits() + ((1u64 << 52) - 1)) >> 52) as i64;
+        let c = e - 1023;
         let d = ((c >> 1).max(0) as usize).min(self.q);
         Plan {
             magnify: c <= 0,
