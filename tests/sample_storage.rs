@@ -185,7 +185,7 @@ fn nearest_mip_level_matches_the_lambda_rule_for_random_footprints() {
         let s = Sampler::new(&chain, o).unwrap();
         // Derivative lengths from 2^-4 to 2^12 texels.
         let len = 2f32.powf(r.f() * 16.0 - 4.0);
-        let ang = r.f() * 6.283;
+        let ang = r.f() * std::f32::consts::TAU;
         let q = Query::new(
             0.37,
             0.61,

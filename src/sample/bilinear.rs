@@ -7,13 +7,16 @@
 //! product would have no fractional bits left at 2048 × 1e6). Weights are
 //! full-precision `f32` (no 8-bit quantization).
 //!
-//! The fast path is a footprint entirely inside the level: one bounds test
-//! per axis, then the two rows are read directly. Footprints that cross an
-//! edge take [`bilinear_edge`], which wraps each axis once (two indices per
-//! axis, not one wrap per texel). Samplers reduce `repeat` and `mirror`
-//! coordinates into their first period before they get here (see
-//! [`super::footprint::Lod::reduce`]), so only lookups that really straddle
-//! an edge leave the fast path.
+//! The fast path is a footprint entirely inside the level: the floor is a
+//! magic-number round ([`floor_fast`]), then one bounds test per axis,
+//! then the rows are read directly. Everything else — NaN, huge and
+//! non-finite positions, footprints that cross an edge — takes one general
+//! path per filter (`bilinear_edge`, `nearest_edge`), which moves `repeat`
+//! and `mirror` coordinates into their first period and wraps each axis
+//! once (two indices per axis, not one wrap per texel). The multi-probe
+//! filters reduce the query's coordinates up front
+//! ([`super::footprint::Lod::reduce`]), so their probes only leave the
+//! fast path where they really straddle an edge.
 //!
 //! Non-finite positions never produce NaN: `floor_index` saturates ±Inf to
 //! ±2^62 (then wrapped like any index) and the fraction is taken as 0.
@@ -22,6 +25,7 @@
 use crate::wrap::{WrapMode, floor_index, wrap_index};
 
 use super::fetch::{Addressing, Chain, Pixel, lerp};
+use super::footprint::reduce_f64;
 use super::trace::TexelSink;
 
 /// Below this magnitude the truncating cast gives the floor directly.
@@ -197,15 +201,9 @@ fn nearest_edge<P: Pixel, S: TexelSink>(
     sink: &mut S,
 ) -> [f32; 4] {
     let l = &c.levels[li];
-    let i = fast_floor(nan0(u) * l.wf);
-    let j = fast_floor(nan0(v) * l.hf);
+    let i = fast_floor(reduce_f64(u, a.wrap.u) * l.wf);
+    let j = fast_floor(reduce_f64(v, a.wrap.v) * l.hf);
     l.fetch(&c.lut, li as u32, i, j, a, sink)
-}
-
-/// NaN read as 0.
-#[inline(always)]
-fn nan0(x: f64) -> f64 {
-    if x.is_nan() { 0.0 } else { x }
 }
 
 /// Bilinear: the 2×2 texels around `(u·w − 0.5, v·h − 0.5)` of level `li`
@@ -280,8 +278,8 @@ fn bilinear_edge<P: Pixel, S: TexelSink>(
     sink: &mut S,
 ) -> [f32; 4] {
     let l = &c.levels[li];
-    let (i0, al) = split(nan0(u) * l.wf - 0.5);
-    let (j0, be) = split(nan0(v) * l.hf - 0.5);
+    let (i0, al) = split(reduce_f64(u, a.wrap.u) * l.wf - 0.5);
+    let (j0, be) = split(reduce_f64(v, a.wrap.v) * l.hf - 0.5);
     let (x0, x1) = axis_pair(a.wrap.u, i0, l.w);
     let (y0, y1) = axis_pair(a.wrap.v, j0, l.h);
     let mut get = |x: Option<u32>, y: Option<u32>| match (x, y) {

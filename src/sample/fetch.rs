@@ -6,7 +6,7 @@
 //! do; grey replicated, missing alpha 1, as
 //! [`crate::texture::expand_to_rgba`] defines). Where that decode happens
 //! depends on the storage type, and every filter is generic over it (the
-//! [`Pixel`] trait), so the choice costs no branch per texel:
+//! `Pixel` trait), so the choice costs no branch per texel:
 //!
 //! - **8-bit chains** (any channel count, sRGB or linear) are kept packed,
 //!   one `[u8; 4]` per texel (grey replicated, missing alpha stored as
@@ -23,17 +23,26 @@
 //! An RGBA8 chain stays at 4 bytes per texel, about 4/3 × 4 bytes per
 //! level-0 texel for a full chain (21 MiB for a 2048² texture) plus the
 //! 4 KiB table; a 1–3 channel 8-bit chain grows to 4 bytes per texel. The
-//! other types take 16 bytes per texel (85 MiB for a 2048² chain). Four
-//! times fewer bytes also means four times more texels per cache line,
-//! which is what the large-footprint filters (anisotropic, EWA) are bound
-//! by. [`LinearChain`] can be shared between samplers with different
-//! options through an `Arc`.
+//! other types take 16 bytes per texel (85 MiB for a 2048² chain).
+//!
+//! The trade-off, measured rather than assumed (`benches/sample.rs` runs
+//! the same queries on both storages): the decode costs a table load per
+//! channel, sixteen per bilinear lookup, and the instructions to extract
+//! the bytes and assemble the vectors — about a third of an RGBA8 bilinear
+//! lookup. When the texels a query set touches fit in the caches, the
+//! `f32` storage is therefore the faster one per lookup; the packed
+//! storage is four times smaller and fetches four times fewer cache lines
+//! per texel, which wins when the working set does not fit. 8-bit chains
+//! are packed because a whole chain at 16 bytes per texel is the larger
+//! cost for most textures. [`LinearChain`] can be shared between samplers
+//! with different options through an `Arc`.
 //!
 //! # Addressing
 //! Filters test once per footprint whether all the texels they need lie
-//! inside the level (the common case) and then index the row directly; only
-//! footprints that cross the edge go through [`Level::fetch`], which wraps
-//! each integer index with [`wrap_index`].
+//! inside the level (the common case) and then index the rows directly;
+//! only footprints that cross the edge take the filters' general paths,
+//! which wrap integer indices with [`wrap_index`] (once per axis for
+//! bilinear, per texel in `Level::fetch` for nearest and EWA).
 
 use std::fmt;
 

@@ -3,21 +3,35 @@
 //!
 //! # Structure
 //! - [`SamplerOptions`] (a hashable value type with presets) and
-//!   [`Sampler`], built once from a [`MipChain`] (decoded to linear RGBA
-//!   `f32` by [`LinearChain`]; see [`fetch`] for the memory cost).
+//!   [`Sampler`], built once from a [`MipChain`] prepared by
+//!   [`LinearChain`]: 8-bit chains stay packed RGBA8 and are decoded at
+//!   fetch through a table, the other types are decoded to RGBA `f32` up
+//!   front (see [`fetch`] for why and for the memory cost).
 //! - [`footprint`](mod@footprint): ρ, η, λ and the mip-level rules, exactly as SPEC.md
-//!   (after Vulkan and EXT_texture_filter_anisotropic) states them.
+//!   (after Vulkan and EXT_texture_filter_anisotropic) states them, plus
+//!   the per-sampler `Lod` that restates the nearest-mip rule without a
+//!   logarithm.
 //! - One file per filter: nearest and bilinear within a level
 //!   (`bilinear`), magnification/minification/mip modes and trilinear
 //!   (`trilinear`), footprint assembly (`aniso`), EWA ([`ewa`]), and the
-//!   supersampled reference (`supersample`). `nearest`, `bilinear`,
-//!   `trilinear` and `aniso` are one code path: footprint assembly with
-//!   `max_aniso = 1` is the isotropic filter.
+//!   supersampled reference (`supersample`). Footprint assembly with
+//!   `max_aniso = 1` is the isotropic lookup, and its probes are isotropic
+//!   lookups sharing one λ and one pair of levels.
 //! - [`trace`]: every filter is generic over a [`TexelSink`] that sees each
 //!   texel read; [`NoTrace`] compiles away.
 //! - `batch`: slices of queries, serial or in parallel (rayon).
 //! - [`plane`]: perspective ground-plane queries, the scene the accuracy
 //!   tests, benchmarks and examples share.
+//!
+//! # Speed
+//! The choices that do not change per query — storage, filters, mip mode,
+//! kernel — are made once per slice of queries ([`Sampler::sample_slice`],
+//! [`Sampler::sample_batch`]; once per call for [`Sampler::sample`]): each
+//! combination is its own monomorphised loop with no branch on them inside.
+//! Within a loop, a lookup whose 2×2 block lies inside the level reads the
+//! rows directly; NaN, huge and edge-crossing positions fall through to one
+//! general path that wraps. No allocation, reference counting or dynamic
+//! dispatch happens per query.
 //!
 //! # Alpha
 //! Texels are filtered as stored, as GPU samplers do: a straight-alpha
@@ -26,11 +40,13 @@
 //! combination of texels (and the border colour), up to `f32` rounding.
 //!
 //! # Extreme inputs (all tested)
-//! - NaN `u` or `v` reads as 0; ±Inf and huge coordinates saturate to
-//!   texel index ±2^62 and are then wrapped, with fraction 0.
-//! - Coordinates far outside [0, 1] are wrapped on integer texel indices
-//!   computed in `f64`, so `u = 1e6` under `repeat` keeps its sub-texel
-//!   position.
+//! - NaN `u` or `v` reads as 0.
+//! - Under `repeat` and `mirror` every finite coordinate is first moved
+//!   into its first period (exactly: `u − floor(u)` has no rounding in
+//!   `f64`), so `u = 1e6` keeps its sub-texel position and `u = 1e30`
+//!   samples where its period puts it. Under the other modes, and for
+//!   ±Inf, positions are floored in `f64` to integer texel indices that
+//!   saturate at ±2^62 (fraction 0) and are then wrapped.
 //! - Zero derivatives: magnification (λ = −∞ before the clamp); EWA uses
 //!   its unit reconstruction Gaussian on level 0.
 //! - NaN or infinite derivatives: an unbounded isotropic footprint (see
