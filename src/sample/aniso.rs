@@ -25,23 +25,55 @@ use super::trace::TexelSink;
 use super::trilinear::{mip_mode, probe};
 use super::{Query, SamplerOptions};
 
-/// Footprint-assembly lookup of `q`.
+/// What footprint assembly needs per query, worked out before any texel
+/// is read: the shared plan, the probe count, the centre (reduced to the
+/// first wrap period) and the longer derivative vector.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Setup {
+    plan: Plan,
+    probes: u32,
+    u: f64,
+    v: f64,
+    major: [f64; 2],
+}
+
+impl Setup {
+    /// A placeholder (overwritten before use).
+    pub const EMPTY: Setup = Setup {
+        plan: Plan::MAGNIFY,
+        probes: 1,
+        u: 0.0,
+        v: 0.0,
+        major: [0.0; 2],
+    };
+}
+
+/// The first half of a footprint-assembly lookup of `q`.
 #[inline(always)]
-pub(crate) fn anisotropic<P: Pixel, S: TexelSink, F: Filters, const MIP: u8>(
-    c: &Chain<P>,
-    f: F,
-    lod: &Lod,
-    o: &SamplerOptions,
-    a: &Addressing,
-    q: &Query,
-    sink: &mut S,
-) -> [f32; 4] {
+pub(crate) fn setup<F: Filters, const MIP: u8>(lod: &Lod, o: &SamplerOptions, q: &Query) -> Setup {
     let (u, v) = lod.reduce(q);
     let fp = footprint_f64(q, lod.wf, lod.hf, o);
-    let plan = Plan::at(fp.lambda, lod.q, mip_mode(MIP));
-    let n = fp.probes;
+    Setup {
+        plan: Plan::at(fp.lambda, lod.q, mip_mode(MIP)),
+        probes: fp.probes,
+        u,
+        v,
+        major: fp.major,
+    }
+}
+
+/// The second half: the probes.
+#[inline(always)]
+pub(crate) fn anisotropic<P: Pixel, S: TexelSink, F: Filters>(
+    c: &Chain<P>,
+    f: F,
+    st: &Setup,
+    a: &Addressing,
+    sink: &mut S,
+) -> [f32; 4] {
+    let (n, u, v) = (st.probes, st.u, st.v);
     if n <= 1 {
-        return probe(c, f, &plan, u, v, a, sink);
+        return probe(c, f, &st.plan, u, v, a, sink);
     }
     let step = 1.0 / (n as f64 + 1.0);
     let inv = 1.0 / n as f32;
@@ -51,9 +83,9 @@ pub(crate) fn anisotropic<P: Pixel, S: TexelSink, F: Filters, const MIP: u8>(
         let p = probe(
             c,
             f,
-            &plan,
-            u + t * fp.major[0],
-            v + t * fp.major[1],
+            &st.plan,
+            u + t * st.major[0],
+            v + t * st.major[1],
             a,
             sink,
         );

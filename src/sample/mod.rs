@@ -690,17 +690,36 @@ impl Sampler {
         sink: &mut S,
     ) {
         let (a, lod, o) = (&self.addr, &self.lod, &self.options);
-        if ANISO {
-            each(queries, out, |q| {
-                aniso::anisotropic::<P, S, F, MIP>(c, f, lod, o, a, q, sink)
-            })
-        } else {
-            each(queries, out, |q| {
-                trilinear::isotropic::<P, S, F, MIP>(c, f, lod, o, a, q, sink)
-            })
+        // Two passes per block of queries: first every footprint (LOD,
+        // levels, probe count), then every texel read. A lookup is one long
+        // chain of dependent steps (derivatives → λ → level → position →
+        // texel → decode); splitting it lets the processor overlap the
+        // arithmetic of one pass's independent queries instead of waiting
+        // on each chain in turn.
+        for (qs, os) in queries.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+            if ANISO {
+                let mut st = [aniso::Setup::EMPTY; BLOCK];
+                for (s, q) in st.iter_mut().zip(qs) {
+                    *s = aniso::setup::<F, MIP>(lod, o, q);
+                }
+                for (s, o) in st.iter().zip(os.iter_mut()) {
+                    *o = aniso::anisotropic(c, f, s, a, sink);
+                }
+            } else {
+                let mut plans = [footprint::Plan::MAGNIFY; BLOCK];
+                for (p, q) in plans.iter_mut().zip(qs) {
+                    *p = trilinear::plan::<F, MIP>(lod, o, q);
+                }
+                for ((p, q), o) in plans.iter().zip(qs).zip(os.iter_mut()) {
+                    *o = trilinear::probe(c, f, p, q.u as f64, q.v as f64, a, sink);
+                }
+            }
         }
     }
 }
+
+/// Queries per block of the two-pass loop (see `Sampler::run_texel`).
+const BLOCK: usize = 16;
 
 /// `out[i] = f(&queries[i])`.
 #[inline(always)]

@@ -60,25 +60,18 @@ pub(crate) fn probe<P: Pixel, S: TexelSink, F: Filters>(
     }
 }
 
-/// Isotropic lookup of `q`.
+/// The plan of an isotropic lookup of `q` (the first half of a lookup;
+/// [`probe`] at `(q.u, q.v)` is the second).
+///
+/// Coordinates are not reduced to the first wrap period: the per-level
+/// filters test whether the footprint is inside the level and wrap only
+/// when not.
 #[inline(always)]
-pub(crate) fn isotropic<P: Pixel, S: TexelSink, F: Filters, const MIP: u8>(
-    c: &Chain<P>,
-    f: F,
-    lod: &Lod,
-    o: &SamplerOptions,
-    a: &Addressing,
-    q: &Query,
-    sink: &mut S,
-) -> [f32; 4] {
-    // Not reduced to the first wrap period: the per-level filters test
-    // whether the footprint is inside the level and wrap only when not.
-    let (u, v) = (q.u as f64, q.v as f64);
-    let plan = match MIP {
+pub(crate) fn plan<F: Filters, const MIP: u8>(lod: &Lod, o: &SamplerOptions, q: &Query) -> Plan {
+    match MIP {
         MIP_NONE if F::SAME => Plan::MAGNIFY,
         MIP_NONE => lod.plan_level0(q),
         MIP_NEAREST => lod.plan_nearest(q),
         _ => Plan::at(lod.lambda(q, o), lod.q, MipMode::Linear),
-    };
-    probe(c, f, &plan, u, v, a, sink)
+    }
 }
