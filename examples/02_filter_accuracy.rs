@@ -14,10 +14,12 @@
 //! of linear RGB.
 //!
 //! The reference is a *box* filter over the pixel footprint. EWA's
-//! Gaussian (weight `exp(−2r²) − exp(−2)` out to one pixel spacing, σ =
-//! half a pixel against the box's 0.29) is deliberately softer: it wins
-//! where aliasing dominates (the zone plate) and loses on sharp edges (the
-//! checker). `tests/sample_accuracy.rs` asserts exactly that ordering.
+//! Gaussian (weight `exp(−2r²) − exp(−2)` out to the ellipse of the
+//! derivative vectors, SPEC.md) is softer: truncated at r = 1 its per-axis
+//! σ is 0.37 of a pixel spacing against the box's 0.29, before the blur of
+//! the mip level it reads. It wins where aliasing dominates (the zone
+//! plate) and loses on sharp edges (the checker); `tests/sample_accuracy.rs`
+//! asserts the zone-plate win on this scene and documents the checker.
 
 use parvo::sample::plane::{GroundPlane, rmse};
 use parvo::sample::{Query, Sampler, SamplerOptions, footprint};

@@ -1,15 +1,24 @@
 //! Accuracy against the supersampled reference on a perspective ground
-//! plane (the scene of `examples/02_filter_accuracy.rs`, at a lower
-//! resolution so the test stays quick in debug builds).
+//! plane: the scene and the numbers of `examples/02_filter_accuracy.rs`
+//! and the README table (256 × 192 pixels, 15° below the horizon, 64 × 64
+//! reference, footprints up to 32 texels).
 //!
-//! Asserted: anisotropic 16 beats trilinear, and EWA beats trilinear, on
-//! both textures. EWA against anisotropic 16 is printed, not asserted: the
-//! reference is a *box* over the pixel footprint, and EWA's Gaussian
-//! (σ = half a pixel spacing, against the box's 0.29) is softer by design.
-//! It wins on the zone plate at 256×192 pixels (the example's table) but
-//! loses on the checker's sharp edges, and at this test's lower resolution
-//! (bigger, more minified pixels) it loses on both. Asserting "EWA beats
-//! aniso 16" would need a scene chosen for it.
+//! Asserted, on the checker and the zone plate: anisotropic 16 beats
+//! trilinear, EWA beats trilinear, and on the zone plate EWA beats
+//! anisotropic 16.
+//!
+//! Not asserted, because it does not hold: EWA beating anisotropic 16 on
+//! the checker (0.0224 against 0.0171). EWA follows SPEC.md (and pbrt's
+//! `MIPMap::EWA`); the gap is the filter shape, not a level or scale
+//! error. The reference is a *box* over the pixel footprint; EWA's
+//! truncated Gaussian `exp(−2r²) − exp(−2)` over the ellipse of the
+//! derivative vectors has a per-axis variance of 0.136·|d|² against the
+//! box's 0.083·|d|², and choosing the level from the minor axis adds the
+//! mip level's own blur. Measured: EWA on level 0 alone (no mip levels)
+//! still loses on the checker (0.0211), and halving the ellipse (radii
+//! |d|/2) doubles the error (0.040) — so the softer shape costs on sharp
+//! edges and pays where aliasing dominates (the zone plate). At a coarser
+//! scene (96 × 72 pixels) EWA loses to anisotropic 16 on both textures.
 
 use parvo::sample::plane::{GroundPlane, rmse};
 use parvo::sample::{Query, Sampler, SamplerOptions, footprint};
@@ -38,9 +47,9 @@ fn scene(w: u32, h: u32) -> Vec<Query> {
 }
 
 #[test]
-fn aniso16_and_ewa_beat_trilinear_against_the_supersampled_reference() {
-    let queries = scene(96, 72);
-    assert!(queries.len() > 2000, "{} queries", queries.len());
+fn aniso16_beats_trilinear_and_ewa_beats_aniso16_on_the_zone_plate() {
+    let queries = scene(256, 192);
+    assert!(queries.len() > 30000, "{} queries", queries.len());
     let filters = [
         SamplerOptions::trilinear(),
         SamplerOptions::aniso(16),
@@ -82,5 +91,9 @@ fn aniso16_and_ewa_beat_trilinear_against_the_supersampled_reference() {
     assert!(
         checker[2] < checker[0] && zone[2] < zone[0],
         "ewa vs trilinear: {results:?}"
+    );
+    assert!(
+        zone[2] < zone[1],
+        "ewa vs aniso16 on the zone plate: {zone:?}"
     );
 }

@@ -3,8 +3,6 @@
 //! derivatives, footprints that only the 1×1 level can serve, tiny
 //! textures, texels near the top of the f32 range.
 
-use std::time::Instant;
-
 use parvo::sample::ewa::MAX_RADIUS;
 use parvo::sample::{
     Filter, LinearChain, MipMode, Query, Sampler, SamplerOptions, TexelCounter, TexelRecorder,
@@ -113,7 +111,6 @@ fn ewa_work_is_bounded_when_the_lod_clamp_forces_level_zero() {
         },
     ] {
         let s = Sampler::from_linear(linear.clone(), o).unwrap();
-        let t = Instant::now();
         for d in [1e30f32, 10.0, 1.0, f32::INFINITY] {
             for q in [
                 Query::new(0.5, 0.5, d, 0.0, 0.0, d),
@@ -131,11 +128,6 @@ fn ewa_work_is_bounded_when_the_lod_clamp_forces_level_zero() {
                 );
             }
         }
-        assert!(
-            t.elapsed().as_secs_f64() < 5.0,
-            "EWA took {:?}",
-            t.elapsed()
-        );
     }
 }
 

@@ -5,51 +5,93 @@
 //! centred on `(u, v)` and spread along the longer derivative vector at
 //! offsets `(i/(N+1) − 1/2)·major`, i = 1..N, each weighted 1/N. With
 //! `max_aniso = 1` (or an isotropic footprint) N = 1 and the single probe
-//! sits at `(u, v)`: this *is* the nearest/bilinear/trilinear path, so
-//! "anisotropic with η = 1 equals trilinear" holds bit for bit.
+//! sits at `(u, v)`: this is the isotropic lookup, so "anisotropic with
+//! η = 1 equals trilinear" holds bit for bit.
+//!
+//! λ, the levels and the blend weight are the same for every probe, so
+//! they are worked out once per query (a [`Plan`]); each probe is then a
+//! trilinear (or nearest/bilinear) read at its position.
 //!
 //! Work per query is bounded by `max_aniso` (≤ 16) probes of at most 8
 //! texels. A probe position is computed in `f64`; huge derivative vectors
-//! give huge (saturated, then wrapped) positions, never NaN.
+//! give huge (saturated, then wrapped) positions, never NaN. Each probe is
+//! scaled by 1/N before it is added, so 16 probes of texels near `f32::MAX`
+//! cannot overflow the sum.
 
-use super::fetch::{Addressing, Level};
-use super::footprint::Footprint;
+use super::bilinear::Filters;
+use super::fetch::{Addressing, Chain, Pixel};
+use super::footprint::{Lod, Plan, footprint_f64};
 use super::trace::TexelSink;
-use super::trilinear::{Iso, isotropic};
+use super::trilinear::{mip_mode, probe};
+use super::{Query, SamplerOptions};
 
-/// Footprint-assembly lookup of `(u, v)` with footprint `fp`.
-#[inline(always)]
-pub(crate) fn anisotropic<S: TexelSink>(
-    levels: &[Level],
-    o: Iso,
-    a: &Addressing,
+/// What footprint assembly needs per query, worked out before any texel
+/// is read: the shared plan, the probe count, the centre (reduced to the
+/// first wrap period) and the longer derivative vector.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Setup {
+    plan: Plan,
+    probes: u32,
     u: f64,
     v: f64,
-    fp: &Footprint,
+    major: [f64; 2],
+}
+
+impl Setup {
+    /// A placeholder (overwritten before use).
+    pub const EMPTY: Setup = Setup {
+        plan: Plan::MAGNIFY,
+        probes: 1,
+        u: 0.0,
+        v: 0.0,
+        major: [0.0; 2],
+    };
+}
+
+/// The first half of a footprint-assembly lookup of `q`.
+#[inline(always)]
+pub(crate) fn setup<F: Filters, const MIP: u8>(lod: &Lod, o: &SamplerOptions, q: &Query) -> Setup {
+    let (u, v) = lod.reduce(q);
+    let fp = footprint_f64(q, lod.wf, lod.hf, o);
+    Setup {
+        plan: Plan::at(fp.lambda, lod.q, mip_mode(MIP)),
+        probes: fp.probes,
+        u,
+        v,
+        major: fp.major,
+    }
+}
+
+/// The second half: the probes.
+#[inline(always)]
+pub(crate) fn anisotropic<P: Pixel, S: TexelSink, F: Filters>(
+    c: &Chain<P>,
+    f: F,
+    st: &Setup,
+    a: &Addressing,
     sink: &mut S,
 ) -> [f32; 4] {
-    let n = fp.probes;
+    let (n, u, v) = (st.probes, st.u, st.v);
     if n <= 1 {
-        return isotropic(levels, o, a, u, v, fp.lambda, sink);
+        return probe(c, f, &st.plan, u, v, a, sink);
     }
     let step = 1.0 / (n as f64 + 1.0);
-    // f64 sum: 16 probes of texels near f32::MAX must not overflow.
-    let mut acc = [0.0f64; 4];
+    let inv = 1.0 / n as f32;
+    let mut acc = [0.0f32; 4];
     for i in 1..=n {
         let t = i as f64 * step - 0.5;
-        let p = isotropic(
-            levels,
-            o,
+        let p = probe(
+            c,
+            f,
+            &st.plan,
+            u + t * st.major[0],
+            v + t * st.major[1],
             a,
-            u + t * fp.major[0],
-            v + t * fp.major[1],
-            fp.lambda,
             sink,
         );
-        for c in 0..4 {
-            acc[c] += p[c] as f64;
+        for k in 0..4 {
+            acc[k] += p[k] * inv;
         }
     }
-    let inv = 1.0 / n as f64;
-    acc.map(|x| (x * inv) as f32)
+    acc
 }

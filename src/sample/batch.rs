@@ -40,9 +40,7 @@ impl Sampler {
         sink: &mut S,
     ) -> Result<()> {
         check_len(queries.len(), out.len())?;
-        for (q, o) in queries.iter().zip(out.iter_mut()) {
-            *o = self.sample_traced(q, sink);
-        }
+        self.run(queries, out, sink);
         Ok(())
     }
 
@@ -52,11 +50,7 @@ impl Sampler {
         queries
             .par_chunks(CHUNK)
             .zip(out.par_chunks_mut(CHUNK))
-            .for_each(|(q, o)| {
-                for (q, o) in q.iter().zip(o.iter_mut()) {
-                    *o = self.sample(q);
-                }
-            });
+            .for_each(|(q, o)| self.run(q, o, &mut NoTrace));
         Ok(())
     }
 
@@ -81,9 +75,7 @@ impl Sampler {
             .map(|(k, (q, o))| {
                 let start = k * CHUNK;
                 let mut sink = make_sink(start);
-                for (q, o) in q.iter().zip(o.iter_mut()) {
-                    *o = self.sample_traced(q, &mut sink);
-                }
+                self.run(q, o, &mut sink);
                 (start, sink)
             })
             .collect())

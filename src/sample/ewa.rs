@@ -34,11 +34,11 @@
 
 use crate::wrap::WrapMode;
 
-use super::MipMode;
 use super::bilinear::{fast_floor, split};
-use super::fetch::{Addressing, Level, lerp};
-use super::footprint::{clamp_lod, levels_for, log2};
+use super::fetch::{Addressing, Chain, Pixel, lerp};
+use super::footprint::{Lod, clamp_lod, derivatives, levels_for, log2};
 use super::trace::TexelSink;
+use super::{Query, SamplerOptions};
 
 /// Largest semi-axis, in texels of the level being filtered, that EWA
 /// scans; larger ellipses are shrunk (see the module docs).
@@ -47,21 +47,18 @@ pub const MAX_RADIUS: f64 = 40.0;
 /// Gaussian falloff α of the EWA weight `exp(−α·r²) − exp(−α)`.
 const ALPHA: f64 = 2.0;
 
-/// EWA lookup. `dx`, `dy` are the (sanitized) derivative vectors in
-/// normalized units.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn ewa<S: TexelSink>(
-    levels: &[Level],
+/// EWA lookup of `q`.
+pub(crate) fn ewa<P: Pixel, S: TexelSink>(
+    c: &Chain<P>,
     a: &Addressing,
-    mip: MipMode,
-    max_aniso: u32,
-    o: &super::SamplerOptions,
-    u: f64,
-    v: f64,
-    dx: [f64; 2],
-    dy: [f64; 2],
+    lod: &Lod,
+    o: &SamplerOptions,
+    q: &Query,
     sink: &mut S,
 ) -> [f32; 4] {
+    let (u, v) = lod.reduce(q);
+    let (dx, dy) = derivatives(q, lod.wf, lod.hf);
+    let levels = &c.levels[..];
     let (w0, h0) = (levels[0].wf, levels[0].hf);
     // Derivative vectors in level-0 texels.
     let (ax, ay) = (dx[0] * w0, dx[1] * h0);
@@ -81,11 +78,10 @@ pub(crate) fn ewa<S: TexelSink>(
     } else {
         (1.0, 0.0)
     };
-    let minor = minor0.max(major / max_aniso.clamp(1, 16) as f64);
+    let minor = minor0.max(major / o.max_aniso.clamp(1, 16) as f64);
     let lambda = clamp_lod(log2(minor), o);
-    let q = levels.len() - 1;
     let (hi, lo, delta) = if lambda > 0.0 {
-        levels_for(lambda, q, mip)
+        levels_for(lambda, lod.q, o.mip)
     } else {
         (0, 0, 0.0)
     };
@@ -95,9 +91,9 @@ pub(crate) fn ewa<S: TexelSink>(
         ex,
         ey,
     };
-    let t = ewa_level(levels, hi, a, &axes, u, v, sink);
+    let t = ewa_level(c, hi, a, &axes, u, v, sink);
     if delta > 0.0 && lo != hi {
-        let t2 = ewa_level(levels, lo, a, &axes, u, v, sink);
+        let t2 = ewa_level(c, lo, a, &axes, u, v, sink);
         lerp(t, t2, delta)
     } else {
         t
@@ -113,8 +109,8 @@ struct Axes {
     ey: f64,
 }
 
-fn ewa_level<S: TexelSink>(
-    levels: &[Level],
+fn ewa_level<P: Pixel, S: TexelSink>(
+    c: &Chain<P>,
     k: usize,
     a: &Addressing,
     axes: &Axes,
@@ -122,14 +118,14 @@ fn ewa_level<S: TexelSink>(
     v: f64,
     sink: &mut S,
 ) -> [f32; 4] {
-    let l = &levels[k];
-    let (sx, sy) = (l.wf / levels[0].wf, l.hf / levels[0].hf);
+    let l = &c.levels[k];
+    let (sx, sy) = (l.wf / c.levels[0].wf, l.hf / c.levels[0].hf);
     if l.w == 1
         && l.h == 1
         && a.wrap.u != WrapMode::ClampToBorder
         && a.wrap.v != WrapMode::ClampToBorder
     {
-        return l.at(k as u32, 0, 0, sink);
+        return l.at(&c.lut, k as u32, 0, 0, sink);
     }
     // Semi-axis vectors in this level's texels.
     let (mut p1x, mut p1y) = (axes.major * axes.ex * sx, axes.major * axes.ey * sy);
@@ -178,6 +174,7 @@ fn ewa_level<S: TexelSink>(
             if r2 < 1.0 {
                 let w = (-ALPHA * r2).exp() - e_alpha;
                 let tex = l.fetch(
+                    &c.lut,
                     k as u32,
                     ib.saturating_add(is),
                     jb.saturating_add(jt),
@@ -196,6 +193,6 @@ fn ewa_level<S: TexelSink>(
     } else {
         // Unreachable in exact arithmetic (the ellipse contains a texel
         // centre); kept so rounding can never divide by zero.
-        l.fetch(k as u32, ib, jb, a, sink)
+        l.fetch(&c.lut, k as u32, ib, jb, a, sink)
     }
 }

@@ -1,75 +1,236 @@
-//! Texel fetch: the decoded, linear-light RGBA copy of a chain that every
-//! filter reads, and the one function that turns an integer texel index
-//! into a colour.
+//! Texel fetch: the copy of a chain that every filter reads, and the
+//! functions that turn an integer texel index into a linear-light colour.
 //!
-//! # Why a decoded copy
+//! # Two storages, one decode step
 //! Filters work in linear light on RGBA `f32` (sRGB decoded first, as GPUs
 //! do; grey replicated, missing alpha 1, as
-//! [`crate::texture::expand_to_rgba`] defines). Decoding per fetch would
-//! cost a table look-up per channel and a branch per storage type in the
-//! innermost loop; decoding the whole chain once makes a fetch a single
-//! 16-byte load for every storage type (u8/u16/f16/f32, 1–4 channels), so
-//! one code path serves them all at the same speed.
+//! [`crate::texture::expand_to_rgba`] defines). Where that decode happens
+//! depends on the storage type, and every filter is generic over it (the
+//! `Pixel` trait), so the choice costs no branch per texel:
 //!
-//! The price is memory: 16 bytes per texel, about 4/3 × 16 bytes per
-//! level-0 texel for a full chain (85 MiB for a 2048² texture, against
-//! 21 MiB for its RGBA8 chain). [`LinearChain`] can be shared between
-//! samplers with different options through an `Arc`.
+//! - **8-bit chains** (any channel count, sRGB or linear) are kept packed,
+//!   one `[u8; 4]` per texel (grey replicated, missing alpha stored as
+//!   255), and decoded at fetch through a 256-entry table per channel
+//!   (4 KiB, in L1 next to the texels). The table is filled by the same
+//!   decoder the rest of the crate uses ([`crate::texel::decode_u8`] then
+//!   `expand_to_rgba`), so a fetch returns exactly what decoding the whole
+//!   chain up front would.
+//! - **16-bit and float chains** are decoded once to RGBA `f32`: there is
+//!   no small table for f16 or u16 sRGB, and a fetch of a decoded texel is a
+//!   single 16-byte load.
+//!
+//! # Memory cost
+//! An RGBA8 chain stays at 4 bytes per texel, about 4/3 × 4 bytes per
+//! level-0 texel for a full chain (21 MiB for a 2048² texture) plus the
+//! 4 KiB table; a 1–3 channel 8-bit chain grows to 4 bytes per texel. The
+//! other types take 16 bytes per texel (85 MiB for a 2048² chain).
+//!
+//! The trade-off, measured rather than assumed (`benches/sample.rs` runs
+//! the same queries on both storages): the decode costs a table load per
+//! channel, sixteen per bilinear lookup, and the instructions to extract
+//! the bytes and assemble the vectors — about a third of an RGBA8 bilinear
+//! lookup. When the texels a query set touches fit in the caches, the
+//! `f32` storage is therefore the faster one per lookup; the packed
+//! storage is four times smaller and fetches four times fewer cache lines
+//! per texel, which wins when the working set does not fit. 8-bit chains
+//! are packed because a whole chain at 16 bytes per texel is the larger
+//! cost for most textures. [`LinearChain`] can be shared between samplers
+//! with different options through an `Arc`.
+//!
+//! # Addressing
+//! Filters test once per footprint whether all the texels they need lie
+//! inside the level (the common case) and then index the rows directly;
+//! only footprints that cross the edge take the filters' general paths,
+//! which wrap integer indices with [`wrap_index`] (once per axis for
+//! bilinear, per texel in `Level::fetch` for nearest and EWA).
+
+use std::fmt;
 
 use rayon::prelude::*;
 
 use crate::mip::MipChain;
-use crate::texel::Format;
-use crate::texture::expand_to_rgba;
+use crate::texel::{Format, Texels};
+use crate::texture::{Texture, expand_to_rgba};
 use crate::wrap::{Wrap, wrap_index};
 
 use super::trace::TexelSink;
 
-/// One level, decoded to linear RGBA f32, row-major.
+/// A stored texel that decodes to linear RGBA `f32`.
+pub(crate) trait Pixel: Copy + Send + Sync + 'static {
+    /// What decoding needs besides the texel (a table, or nothing).
+    type Lut: Send + Sync + fmt::Debug + Clone;
+    /// The linear-light RGBA value.
+    fn decode(self, lut: &Self::Lut) -> [f32; 4];
+
+    /// Bilinear blend of a 2×2 block `[t00, t10, t01, t11]` with fractions
+    /// α (along x) and β (along y): `lerp(lerp(t00, t10, α), lerp(t01,
+    /// t11, α), β)` in linear light.
+    #[inline(always)]
+    fn bilerp(t: [Self; 4], lut: &Self::Lut, al: f32, be: f32) -> [f32; 4] {
+        lerp(
+            lerp(t[0].decode(lut), t[1].decode(lut), al),
+            lerp(t[2].decode(lut), t[3].decode(lut), al),
+            be,
+        )
+    }
+}
+
+impl Pixel for [f32; 4] {
+    type Lut = ();
+    #[inline(always)]
+    fn decode(self, _: &()) -> [f32; 4] {
+        self
+    }
+}
+
+/// Per-channel decode table of a packed 8-bit chain: `table[c][i]` is the
+/// linear value of code `i` in channel `c`.
+#[derive(Clone)]
+pub(crate) struct Lut8(Box<[[f32; 256]; 4]>);
+
+impl fmt::Debug for Lut8 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("Lut8")
+    }
+}
+
+impl Pixel for [u8; 4] {
+    type Lut = Lut8;
+    #[inline(always)]
+    fn decode(self, lut: &Lut8) -> [f32; 4] {
+        let t = &*lut.0;
+        [
+            t[0][self[0] as usize],
+            t[1][self[1] as usize],
+            t[2][self[2] as usize],
+            t[3][self[3] as usize],
+        ]
+    }
+}
+
+/// One level, row-major.
 #[derive(Clone, Debug)]
-pub(crate) struct Level {
+pub(crate) struct Level<P> {
     pub w: u32,
     pub h: u32,
     pub wf: f64,
     pub hf: f64,
-    pub texels: Box<[[f32; 4]]>,
+    pub texels: Box<[P]>,
 }
 
-/// A mip chain decoded to linear-light RGBA `f32` (see the module docs for
-/// the memory cost).
+/// Every level of a chain in one storage, with its decode table.
+#[derive(Clone, Debug)]
+pub(crate) struct Chain<P: Pixel> {
+    pub levels: Box<[Level<P>]>,
+    pub lut: P::Lut,
+}
+
+/// The storage a chain is kept in (see the module docs).
+#[derive(Clone, Debug)]
+pub(crate) enum Store {
+    /// Packed 8-bit texels, decoded at fetch.
+    Rgba8(Chain<[u8; 4]>),
+    /// Texels decoded to linear RGBA `f32` up front.
+    F32(Chain<[f32; 4]>),
+}
+
+/// A mip chain as the samplers read it: packed RGBA8 with a decode table
+/// for 8-bit textures, linear RGBA `f32` for the others (see the module
+/// docs for the memory cost). Every accessor returns decoded linear-light
+/// values whatever the storage.
 #[derive(Clone, Debug)]
 pub struct LinearChain {
-    pub(crate) levels: Vec<Level>,
+    pub(crate) store: Store,
     format: Format,
 }
 
-impl LinearChain {
-    /// Decode every level of `chain` (in parallel).
-    pub fn new(chain: &MipChain) -> Self {
-        let levels = chain
-            .levels()
-            .iter()
-            .map(|t| {
-                let ch = t.channels();
-                let linear = t.to_linear();
-                let texels: Vec<[f32; 4]> = linear
-                    .par_chunks_exact(ch)
+fn level<P>(t: &Texture, texels: Vec<P>) -> Level<P> {
+    Level {
+        w: t.width(),
+        h: t.height(),
+        wf: t.width() as f64,
+        hf: t.height() as f64,
+        texels: texels.into_boxed_slice(),
+    }
+}
+
+/// Pack 1–4 channel 8-bit values into RGBA8: grey replicated, missing
+/// alpha 255 (the table decodes it to 1 anyway).
+fn pack8(v: &[u8]) -> [u8; 4] {
+    match *v {
+        [g] => [g, g, g, 255],
+        [g, a] => [g, g, g, a],
+        [r, g, b] => [r, g, b, 255],
+        [r, g, b, a, ..] => [r, g, b, a],
+        [] => [0, 0, 0, 255],
+    }
+}
+
+/// The levels of an 8-bit chain packed to RGBA8, or `None` when the chain
+/// is not 8-bit.
+fn packed8(chain: &MipChain) -> Option<Box<[Level<[u8; 4]>]>> {
+    chain
+        .levels()
+        .iter()
+        .map(|t| match t.texels() {
+            Texels::U8(v) => {
+                let texels = v
+                    .par_chunks_exact(t.channels())
                     .with_min_len(4096)
-                    .map(expand_to_rgba)
+                    .map(pack8)
                     .collect();
-                Level {
-                    w: t.width(),
-                    h: t.height(),
-                    wf: t.width() as f64,
-                    hf: t.height() as f64,
-                    texels: texels.into_boxed_slice(),
-                }
-            })
-            .collect();
-        LinearChain {
-            levels,
-            format: chain.levels()[0].format(),
+                Some(level(t, texels))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// The decode table of 8-bit `format`: code `i` in every channel, decoded
+/// by the crate's decoder and expanded to RGBA.
+fn lut8(format: &Format) -> Lut8 {
+    let ch = format.channels as usize;
+    let mut t = Box::new([[0f32; 256]; 4]);
+    for i in 0..256 {
+        let codes = [i as u8; 4];
+        let mut lin = [0f32; 4];
+        crate::texel::decode_u8(format, &codes[..ch], &mut lin[..ch]);
+        for (c, x) in expand_to_rgba(&lin[..ch]).into_iter().enumerate() {
+            t[c][i] = x;
         }
+    }
+    Lut8(t)
+}
+
+impl LinearChain {
+    /// Prepare every level of `chain` (in parallel): packed for 8-bit
+    /// storage, decoded to linear `f32` otherwise.
+    pub fn new(chain: &MipChain) -> Self {
+        let format = chain.levels()[0].format();
+        let store = match packed8(chain) {
+            Some(levels) => Store::Rgba8(Chain {
+                levels,
+                lut: lut8(&format),
+            }),
+            None => {
+                let levels = chain
+                    .levels()
+                    .iter()
+                    .map(|t| {
+                        let ch = t.channels();
+                        let linear = t.to_linear();
+                        let texels: Vec<[f32; 4]> = linear
+                            .par_chunks_exact(ch)
+                            .with_min_len(4096)
+                            .map(expand_to_rgba)
+                            .collect();
+                        level(t, texels)
+                    })
+                    .collect();
+                Store::F32(Chain { levels, lut: () })
+            }
+        };
+        LinearChain { store, format }
     }
 
     /// Format of the source chain (its channel count decides how many
@@ -80,31 +241,58 @@ impl LinearChain {
 
     /// Number of levels.
     pub fn len(&self) -> usize {
-        self.levels.len()
+        match &self.store {
+            Store::Rgba8(c) => c.levels.len(),
+            Store::F32(c) => c.levels.len(),
+        }
     }
 
     /// Always false: a chain has level 0.
     pub fn is_empty(&self) -> bool {
-        self.levels.is_empty()
+        self.len() == 0
     }
 
     /// Size of level `k`.
     pub fn level_size(&self, k: usize) -> Option<(u32, u32)> {
-        self.levels.get(k).map(|l| (l.w, l.h))
+        match &self.store {
+            Store::Rgba8(c) => c.levels.get(k).map(|l| (l.w, l.h)),
+            Store::F32(c) => c.levels.get(k).map(|l| (l.w, l.h)),
+        }
     }
 
-    /// Bytes held by the decoded texels.
+    /// Bytes held by the stored texels and the decode table.
     pub fn memory_bytes(&self) -> usize {
-        self.levels
-            .iter()
-            .map(|l| l.texels.len() * std::mem::size_of::<[f32; 4]>())
-            .sum()
+        fn bytes<P: Pixel>(c: &Chain<P>) -> usize {
+            c.levels
+                .iter()
+                .map(|l| std::mem::size_of_val(&*l.texels))
+                .sum()
+        }
+        match &self.store {
+            Store::Rgba8(c) => bytes(c) + std::mem::size_of_val(&*c.lut.0),
+            Store::F32(c) => bytes(c),
+        }
     }
 
     /// Decoded texel `(x, y)` of level `k`, or `None` out of range.
     pub fn texel(&self, k: usize, x: u32, y: u32) -> Option<[f32; 4]> {
-        let l = self.levels.get(k)?;
-        (x < l.w && y < l.h).then(|| l.texels[y as usize * l.w as usize + x as usize])
+        fn get<P: Pixel>(c: &Chain<P>, k: usize, x: u32, y: u32) -> Option<[f32; 4]> {
+            let l = c.levels.get(k)?;
+            (x < l.w && y < l.h)
+                .then(|| l.texels[y as usize * l.w as usize + x as usize].decode(&c.lut))
+        }
+        match &self.store {
+            Store::Rgba8(c) => get(c, k, x, y),
+            Store::F32(c) => get(c, k, x, y),
+        }
+    }
+
+    /// The width and height of level 0 as `f64`.
+    pub(crate) fn size0(&self) -> (f64, f64) {
+        match &self.store {
+            Store::Rgba8(c) => (c.levels[0].wf, c.levels[0].hf),
+            Store::F32(c) => (c.levels[0].wf, c.levels[0].hf),
+        }
     }
 }
 
@@ -115,38 +303,43 @@ pub(crate) struct Addressing {
     pub border: [f32; 4],
 }
 
-impl Level {
+impl<P: Pixel> Level<P> {
     /// The texel at integer index `(i, j)` after wrapping, or the border
     /// colour; reports the read to `sink`.
     #[inline(always)]
     pub fn fetch<S: TexelSink>(
         &self,
+        lut: &P::Lut,
         li: u32,
         i: i64,
         j: i64,
         a: &Addressing,
         sink: &mut S,
     ) -> [f32; 4] {
-        if (0..self.w as i64).contains(&i) && (0..self.h as i64).contains(&j) {
-            return self.at(li, i as usize, j as usize, sink);
+        if (i as u64) < self.w as u64 && (j as u64) < self.h as u64 {
+            return self.at(lut, li, i as usize, j as usize, sink);
         }
         match (
             wrap_index(a.wrap.u, i, self.w),
             wrap_index(a.wrap.v, j, self.h),
         ) {
-            (Some(x), Some(y)) => {
-                sink.texel(li, x, y);
-                self.texels[y as usize * self.w as usize + x as usize]
-            }
+            (Some(x), Some(y)) => self.at(lut, li, x as usize, y as usize, sink),
             _ => a.border,
         }
     }
 
     /// Texel at an in-range index (caller checked `x < w`, `y < h`).
     #[inline(always)]
-    pub fn at<S: TexelSink>(&self, li: u32, x: usize, y: usize, sink: &mut S) -> [f32; 4] {
+    pub fn at<S: TexelSink>(
+        &self,
+        lut: &P::Lut,
+        li: u32,
+        x: usize,
+        y: usize,
+        sink: &mut S,
+    ) -> [f32; 4] {
         sink.texel(li, x as u32, y as u32);
-        self.texels[y * self.w as usize + x]
+        self.texels[y * self.w as usize + x].decode(lut)
     }
 }
 

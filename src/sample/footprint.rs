@@ -15,7 +15,13 @@
 //!   the clamp, the coarsest level allowed is used, and there is one probe;
 //! - finite but huge derivatives (1e30) follow the formulas; they select
 //!   the coarsest level like the unbounded case, at constant cost.
+//!
+//! The isotropic nearest-mip path does not take the logarithm at all:
+//! `Lod` restates SPEC's rounding rule on ρ² (exact at the thresholds).
 
+use crate::wrap::WrapMode;
+
+use super::bilinear::fast_floor;
 use super::{MipMode, Query, SamplerOptions};
 
 /// Size in level-0 texels assumed for a footprint with a NaN or infinite
@@ -46,7 +52,7 @@ pub struct Footprint {
 /// non-finite rule of the module docs applied.
 #[inline(always)]
 pub(crate) fn derivatives(q: &Query, wf: f64, hf: f64) -> ([f64; 2], [f64; 2]) {
-    if q.dudx.is_finite() && q.dvdx.is_finite() && q.dudy.is_finite() && q.dvdy.is_finite() {
+    if finite(q) {
         (
             [q.dudx as f64, q.dvdx as f64],
             [q.dudy as f64, q.dvdy as f64],
@@ -54,6 +60,12 @@ pub(crate) fn derivatives(q: &Query, wf: f64, hf: f64) -> ([f64; 2], [f64; 2]) {
     } else {
         ([UNBOUNDED_TEXELS / wf, 0.0], [0.0, UNBOUNDED_TEXELS / hf])
     }
+}
+
+/// True when all four derivatives are finite.
+#[inline(always)]
+fn finite(q: &Query) -> bool {
+    q.dudx.is_finite() && q.dvdx.is_finite() && q.dudy.is_finite() && q.dvdy.is_finite()
 }
 
 /// λ = clamp(base + bias, lodMin, lodMax) as `f32` (base may be −∞).
@@ -65,15 +77,28 @@ pub(crate) fn clamp_lod(base: f64, o: &SamplerOptions) -> f32 {
 /// The footprint of `q` on a texture whose level 0 is `width × height`,
 /// with the LOD bias, clamp and maximum anisotropy of `o` (isotropic
 /// filters have `max_aniso == 1`, so η = 1 and one probe).
-#[inline(always)]
+#[inline]
 pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Footprint {
-    let (wf, hf) = (width as f64, height as f64);
+    footprint_f64(q, width as f64, height as f64, o)
+}
+
+/// [`footprint`] with the level-0 size as `f64`.
+#[inline(always)]
+pub(crate) fn footprint_f64(q: &Query, wf: f64, hf: f64, o: &SamplerOptions) -> Footprint {
     let (dx, dy) = derivatives(q, wf, hf);
     // Squared lengths first (plain products, not the `hypot` library
     // call: the squares of finite f32 derivatives times a u32 size stay far
     // inside the f64 range).
-    let rx2 = square_len(dx[0] * wf, dx[1] * hf);
-    let ry2 = square_len(dy[0] * wf, dy[1] * hf);
+    let (rx2, ry2) = if finite(q) {
+        (
+            square_len(dx[0] * wf, dx[1] * hf),
+            square_len(dy[0] * wf, dy[1] * hf),
+        )
+    } else {
+        // The unbounded footprint, exactly UNBOUNDED_TEXELS texels (as
+        // `Lod::rho2` has it).
+        (UNBOUNDED_RHO2, UNBOUNDED_RHO2)
+    };
     let (rho_x, rho_y) = (rx2.sqrt(), ry2.sqrt());
     let (max2, rho_max, rho_min, major) = if rx2 >= ry2 {
         (rx2, rho_x, rho_y, dx)
@@ -89,7 +114,8 @@ pub fn footprint(q: &Query, width: u32, height: u32, o: &SamplerOptions) -> Foot
         (rho_max / rho_min).min(n)
     };
     // log2(ρmax/η) as ½·log2(ρmax²/η²): for η = 1 this is bit for bit the
-    // isotropic path's λ, so aniso with η = 1 equals trilinear exactly.
+    // isotropic path's λ (`Lod::lambda`), so aniso with η = 1 equals
+    // trilinear exactly.
     let lambda = clamp_lod(0.5 * log2(max2 / (eta * eta)), o);
     Footprint {
         rho_x,
@@ -160,17 +186,6 @@ const fn log2_series(m: f64) -> f64 {
     e + 2.0 * sum * std::f64::consts::LOG2_E
 }
 
-/// λ of an isotropic filter (`max_aniso == 1`): η = 1, so
-/// λ = clamp(½·log2(max(ρx², ρy²)) + bias) — no square roots.
-#[inline(always)]
-pub(crate) fn isotropic_lambda(q: &Query, wf: f64, hf: f64, o: &SamplerOptions) -> f32 {
-    let (dx, dy) = derivatives(q, wf, hf);
-    let (ax, ay) = (dx[0] * wf, dx[1] * hf);
-    let (bx, by) = (dy[0] * wf, dy[1] * hf);
-    let r2 = square_len(ax, ay).max(square_len(bx, by));
-    clamp_lod(0.5 * log2(r2), o)
-}
-
 /// ceil of η ∈ [1, 16] without the `f64::ceil` library call.
 #[inline(always)]
 fn ceil_small(eta: f64) -> u32 {
@@ -217,5 +232,196 @@ pub(crate) fn levels_for(lambda: f32, q: usize, mip: MipMode) -> (usize, usize, 
             (d, d, 0.0)
         }
         MipMode::Linear => mip_linear(lambda, q),
+    }
+}
+
+/// What an isotropic lookup (or one anisotropic probe) reads: the
+/// magnification filter on level 0, or the minification filter on level
+/// `hi` blended with level `lo` by `delta` (one level when `delta` is 0 or
+/// `lo == hi`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Plan {
+    pub magnify: bool,
+    pub hi: usize,
+    pub lo: usize,
+    pub delta: f32,
+}
+
+impl Plan {
+    /// Magnification: level 0 only.
+    pub const MAGNIFY: Plan = Plan {
+        magnify: true,
+        hi: 0,
+        lo: 0,
+        delta: 0.0,
+    };
+
+    /// The plan for λ with mip mode `mip` in a chain whose last level is
+    /// `q` (SPEC "Level of detail").
+    #[inline(always)]
+    pub fn at(lambda: f32, q: usize, mip: MipMode) -> Plan {
+        // λ is never NaN (see `footprint`); the guard costs nothing.
+        if lambda <= 0.0 || lambda.is_nan() {
+            return Plan::MAGNIFY;
+        }
+        let (hi, lo, delta) = levels_for(lambda, q, mip);
+        Plan {
+            magnify: false,
+            hi,
+            lo,
+            delta,
+        }
+    }
+}
+
+/// ρ² of an isotropic footprint with a NaN or infinite derivative:
+/// [`UNBOUNDED_TEXELS`]².
+const UNBOUNDED_RHO2: f64 = UNBOUNDED_TEXELS * UNBOUNDED_TEXELS;
+
+/// 2^x, exact when `x` is an integer (so thresholds at whole and half
+/// LODs are exact), 0 or ∞ beyond the `f64` range. Setup only.
+fn exp2_split(x: f64) -> f64 {
+    let i = x.floor();
+    let i = i.clamp(-1100.0, 1100.0);
+    (x - i).clamp(0.0, 1.0).exp2() * 2f64.powi(i as i32)
+}
+
+/// The LOD rules of one sampler, prepared once: level-0 size, bias and
+/// clamp, and the same rules restated on ρ² for the nearest-mip path.
+///
+/// # λ without a logarithm (nearest mip mode)
+/// λ' = ½·log2(ρ²) + bias = ½·log2(y) with y = ρ²·4^bias, and the clamp
+/// to [lodMin, lodMax] is a clamp of y to [4^lodMin, 4^lodMax]. Then with
+/// c = ceil(log2 y) (the exponent of y, plus one unless y is a power of
+/// two): λ ≤ 0 ⟺ c ≤ 0, and λ ∈ (k − ½, k + ½] ⟺ c ∈ {2k, 2k + 1}, so
+/// SPEC's nearest level d = ceil(d' + ½) − 1 is ⌊c/2⌋ clamped to [0, q].
+/// At the thresholds themselves (λ = k + ½, i.e. y = 2^(2k+1)) y is an
+/// exact power of two whenever the bias and clamps are multiples of ½, so
+/// the rounding rule is exact there; elsewhere the answer differs from
+/// the logarithm route only by the rounding of one product.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lod {
+    /// Level-0 width and height.
+    pub wf: f64,
+    pub hf: f64,
+    /// Last level index.
+    pub q: usize,
+    /// 4^bias (clamped so that 0·4^bias stays 0 and ∞ stays ∞).
+    scale: f64,
+    /// 4^lodMin and 4^lodMax.
+    y_min: f64,
+    y_max: f64,
+    /// Wrap modes, for [`Lod::reduce`].
+    wrap_u: WrapMode,
+    wrap_v: WrapMode,
+}
+
+impl Lod {
+    /// Prepare the rules of `o` for a chain of `levels` levels whose level
+    /// 0 is `wf × hf`.
+    pub fn new(o: &SamplerOptions, wf: f64, hf: f64, levels: usize) -> Lod {
+        Lod {
+            wf,
+            hf,
+            q: levels - 1,
+            scale: exp2_split(2.0 * o.lod_bias as f64).clamp(2f64.powi(-1000), 2f64.powi(1000)),
+            y_min: exp2_split(2.0 * o.lod_min as f64),
+            y_max: exp2_split(2.0 * o.lod_max as f64),
+            wrap_u: o.wrap.u,
+            wrap_v: o.wrap.v,
+        }
+    }
+
+    /// ρmax² = max(ρx², ρy²) in level-0 texels, [`UNBOUNDED_TEXELS`]² when
+    /// a derivative is NaN or infinite (the rule of the module docs).
+    #[inline(always)]
+    pub fn rho2(&self, q: &Query) -> f64 {
+        let (ax, ay) = (q.dudx as f64 * self.wf, q.dvdx as f64 * self.hf);
+        let (bx, by) = (q.dudy as f64 * self.wf, q.dvdy as f64 * self.hf);
+        let rx2 = square_len(ax, ay);
+        let ry2 = square_len(bx, by);
+        // Finite f32 derivatives times a u32 size square far inside the
+        // f64 range, so the sum is finite exactly when all four are.
+        if (rx2 + ry2).is_nan() || rx2 + ry2 > f64::MAX {
+            return UNBOUNDED_RHO2;
+        }
+        // Not `f64::max`: neither is NaN here, and a plain compare is one
+        // instruction.
+        if rx2 >= ry2 { rx2 } else { ry2 }
+    }
+
+    /// λ of an isotropic filter (`max_aniso == 1`): η = 1, so
+    /// λ = clamp(½·log2(ρmax²) + bias) — the same arithmetic as
+    /// [`footprint`] with η = 1, so anisotropic filtering of an isotropic
+    /// footprint equals the isotropic filter bit for bit.
+    #[inline(always)]
+    pub fn lambda(&self, q: &Query, o: &SamplerOptions) -> f32 {
+        clamp_lod(0.5 * log2(self.rho2(q)), o)
+    }
+
+    /// y = clamp(ρmax²·4^bias, 4^lodMin, 4^lodMax) (never NaN).
+    #[inline(always)]
+    fn y(&self, q: &Query) -> f64 {
+        let y = self.rho2(q) * self.scale;
+        let y = if y < self.y_min { self.y_min } else { y };
+        if y > self.y_max { self.y_max } else { y }
+    }
+
+    /// The nearest-mip plan of an isotropic footprint, without a logarithm
+    /// (see the type docs).
+    #[inline(always)]
+    pub fn plan_nearest(&self, q: &Query) -> Plan {
+        // y ≥ 0, so its bits order like the value; adding the mantissa
+        // mask carries into the exponent exactly when y is not a power of
+        // two: the exponent field is then c + 1023.
+        let e = ((self.y(q).to_bits() + ((1u64 << 52) - 1)) >> 52) as i64;
+        let c = e - 1023;
+        let d = ((c >> 1).max(0) as usize).min(self.q);
+        Plan {
+            magnify: c <= 0,
+            hi: d,
+            lo: d,
+            delta: 0.0,
+        }
+    }
+
+    /// Magnification or minification, both on level 0 (mip mode none).
+    #[inline(always)]
+    pub fn plan_level0(&self, q: &Query) -> Plan {
+        let y = self.y(q);
+        Plan {
+            magnify: y <= 1.0,
+            ..Plan::MAGNIFY
+        }
+    }
+
+    /// `(u, v)` moved into the first period of the `repeat` (or `mirror`)
+    /// wrap mode of each axis, exactly: for an `f32` coordinate `u − k`
+    /// (k an integer, or an even integer for `mirror`) has no rounding in
+    /// `f64`, and every level's texel index moves by a whole number of
+    /// periods. After it, only footprints that really cross an edge take
+    /// the wrapping path. NaN reads as 0; infinite coordinates stay as
+    /// they are (and saturate later).
+    #[inline(always)]
+    pub fn reduce(&self, q: &Query) -> (f64, f64) {
+        (reduce(q.u, self.wrap_u), reduce(q.v, self.wrap_v))
+    }
+}
+
+#[inline(always)]
+fn reduce(x: f32, mode: WrapMode) -> f64 {
+    reduce_f64(x as f64, mode)
+}
+
+/// One coordinate moved into the first period of `repeat` (period 1) or
+/// `mirror` (period 2), exactly (`x − floor(x)` has no rounding in `f64`);
+/// NaN reads as 0, infinities and the other modes pass through.
+#[inline(always)]
+pub(crate) fn reduce_f64(x: f64, mode: WrapMode) -> f64 {
+    let x = if x.is_nan() { 0.0 } else { x };
+    match mode {
+        WrapMode::Repeat if x.is_finite() => x - fast_floor(x) as f64,
+        WrapMode::MirroredRepeat if x.is_finite() => x - 2.0 * fast_floor(0.5 * x) as f64,
+        _ => x,
     }
 }

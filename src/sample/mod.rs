@@ -3,21 +3,35 @@
 //!
 //! # Structure
 //! - [`SamplerOptions`] (a hashable value type with presets) and
-//!   [`Sampler`], built once from a [`MipChain`] (decoded to linear RGBA
-//!   `f32` by [`LinearChain`]; see [`fetch`] for the memory cost).
+//!   [`Sampler`], built once from a [`MipChain`] prepared by
+//!   [`LinearChain`]: 8-bit chains stay packed RGBA8 and are decoded at
+//!   fetch through a table, the other types are decoded to RGBA `f32` up
+//!   front (see [`fetch`] for why and for the memory cost).
 //! - [`footprint`](mod@footprint): ρ, η, λ and the mip-level rules, exactly as SPEC.md
-//!   (after Vulkan and EXT_texture_filter_anisotropic) states them.
+//!   (after Vulkan and EXT_texture_filter_anisotropic) states them, plus
+//!   the per-sampler `Lod` that restates the nearest-mip rule without a
+//!   logarithm.
 //! - One file per filter: nearest and bilinear within a level
 //!   (`bilinear`), magnification/minification/mip modes and trilinear
 //!   (`trilinear`), footprint assembly (`aniso`), EWA ([`ewa`]), and the
-//!   supersampled reference (`supersample`). `nearest`, `bilinear`,
-//!   `trilinear` and `aniso` are one code path: footprint assembly with
-//!   `max_aniso = 1` is the isotropic filter.
+//!   supersampled reference (`supersample`). Footprint assembly with
+//!   `max_aniso = 1` is the isotropic lookup, and its probes are isotropic
+//!   lookups sharing one λ and one pair of levels.
 //! - [`trace`]: every filter is generic over a [`TexelSink`] that sees each
 //!   texel read; [`NoTrace`] compiles away.
 //! - `batch`: slices of queries, serial or in parallel (rayon).
 //! - [`plane`]: perspective ground-plane queries, the scene the accuracy
 //!   tests, benchmarks and examples share.
+//!
+//! # Speed
+//! The choices that do not change per query — storage, filters, mip mode,
+//! kernel — are made once per slice of queries ([`Sampler::sample_slice`],
+//! [`Sampler::sample_batch`]; once per call for [`Sampler::sample`]): each
+//! combination is its own monomorphised loop with no branch on them inside.
+//! Within a loop, a lookup whose 2×2 block lies inside the level reads the
+//! rows directly; NaN, huge and edge-crossing positions fall through to one
+//! general path that wraps. No allocation, reference counting or dynamic
+//! dispatch happens per query.
 //!
 //! # Alpha
 //! Texels are filtered as stored, as GPU samplers do: a straight-alpha
@@ -26,11 +40,13 @@
 //! combination of texels (and the border colour), up to `f32` rounding.
 //!
 //! # Extreme inputs (all tested)
-//! - NaN `u` or `v` reads as 0; ±Inf and huge coordinates saturate to
-//!   texel index ±2^62 and are then wrapped, with fraction 0.
-//! - Coordinates far outside [0, 1] are wrapped on integer texel indices
-//!   computed in `f64`, so `u = 1e6` under `repeat` keeps its sub-texel
-//!   position.
+//! - NaN `u` or `v` reads as 0.
+//! - Under `repeat` and `mirror` every finite coordinate is first moved
+//!   into its first period (exactly: `u − floor(u)` has no rounding in
+//!   `f64`), so `u = 1e6` keeps its sub-texel position and `u = 1e30`
+//!   samples where its period puts it. Under the other modes, and for
+//!   ±Inf, positions are floored in `f64` to integer texel indices that
+//!   saturate at ±2^62 (fraction 0) and are then wrapped.
 //! - Zero derivatives: magnification (λ = −∞ before the clamp); EWA uses
 //!   its unit reconstruction Gaussian on level 0.
 //! - NaN or infinite derivatives: an unbounded isotropic footprint (see
@@ -83,8 +99,9 @@ pub use footprint::{Footprint, footprint, mip_linear, mip_nearest};
 pub use query::Query;
 pub use trace::{NoTrace, TexelCounter, TexelRead, TexelRecorder, TexelSink};
 
-use fetch::Addressing;
-use trilinear::Iso;
+use bilinear::{Filters, Lin, MagMin, Near};
+use fetch::{Addressing, Chain, Pixel, Store};
+use footprint::Lod;
 
 /// Filter names used on the command line and in reports (SPEC.md "Names
 /// used on the command line"). Each maps to a preset of
@@ -476,6 +493,7 @@ impl fmt::Display for SamplerOptions {
 enum Kernel {
     /// `Texel` with `max_aniso == 1`: η = 1, one probe, λ without roots.
     Isotropic,
+    /// `Texel` with `max_aniso > 1`: footprint assembly.
     Texel,
     Ewa,
     Supersample,
@@ -485,23 +503,28 @@ enum Kernel {
 
 /// A texture ready to be sampled with one set of options.
 ///
-/// Building it decodes the chain to linear RGBA `f32` once
-/// ([`LinearChain`]); [`Sampler::from_linear`] shares a decoded chain
-/// between samplers. Lookups take `&self` and are safe to run from many
-/// threads.
+/// Building it prepares the chain once ([`LinearChain`]: packed RGBA8 for
+/// 8-bit textures, linear RGBA `f32` otherwise); [`Sampler::from_linear`]
+/// shares a prepared chain between samplers. Lookups take `&self` and are
+/// safe to run from many threads.
+///
+/// Every lookup goes through one dispatch on the storage, the filter and
+/// the mip mode, made once per slice of queries (once per call for
+/// [`Sampler::sample`]); the loop inside is compiled for that combination
+/// alone.
 #[derive(Clone, Debug)]
 pub struct Sampler {
     chain: Arc<LinearChain>,
     options: SamplerOptions,
     kernel: Kernel,
     addr: Addressing,
-    iso: Iso,
+    lod: Lod,
     sat: Option<Arc<SatSampler>>,
 }
 
 impl Sampler {
-    /// Decode `chain` and check `options` (an [`Error::InvalidOption`] for
-    /// out-of-range values and for the `sat` filter, which needs a
+    /// Prepare `chain` and check `options` (an [`Error::InvalidOption`]
+    /// for out-of-range values and for the `sat` filter, which needs a
     /// summed-area table).
     ///
     /// For `sat` the summed-area table of level 0 is built here (the
@@ -526,7 +549,7 @@ impl Sampler {
         Ok(s)
     }
 
-    /// A sampler over an already decoded chain.
+    /// A sampler over an already prepared chain.
     /// The `sat` filter needs the stored level 0 and is refused here: use
     /// [`Sampler::new`].
     pub fn from_linear(chain: Arc<LinearChain>, options: SamplerOptions) -> Result<Self> {
@@ -543,6 +566,8 @@ impl Sampler {
             Method::Sat if have_sat => Kernel::Sat,
             Method::Sat => return Err(sat_unavailable()),
         };
+        let (wf, hf) = chain.size0();
+        let lod = Lod::new(&options, wf, hf, chain.len());
         Ok(Sampler {
             chain,
             options,
@@ -551,11 +576,7 @@ impl Sampler {
                 wrap: options.wrap,
                 border: options.border,
             },
-            iso: Iso {
-                mag: options.mag,
-                min: options.min,
-                mip: options.mip,
-            },
+            lod,
             sat: None,
         })
     }
@@ -565,15 +586,14 @@ impl Sampler {
         &self.options
     }
 
-    /// The decoded chain.
+    /// The prepared chain.
     pub fn chain(&self) -> &Arc<LinearChain> {
         &self.chain
     }
 
     /// LOD and anisotropy of `q` under these options.
     pub fn footprint(&self, q: &Query) -> Footprint {
-        let l = &self.chain.levels[0];
-        footprint(q, l.w, l.h, &self.options)
+        footprint::footprint_f64(q, self.lod.wf, self.lod.hf, &self.options)
     }
 
     /// Filtered linear RGBA colour at `q`.
@@ -585,55 +605,127 @@ impl Sampler {
     /// [`Sampler::sample`], reporting every texel read to `sink`.
     #[inline]
     pub fn sample_traced<S: TexelSink>(&self, q: &Query, sink: &mut S) -> [f32; 4] {
-        let levels = &self.chain.levels[..];
-        let u = coord(q.u);
-        let v = coord(q.v);
+        let mut out = [[0.0; 4]];
+        self.run(std::slice::from_ref(q), &mut out, sink);
+        out[0]
+    }
+
+    /// Sample `queries` into `out` (same length) in order, reporting to
+    /// `sink`: the one dispatch point of every lookup.
+    pub(crate) fn run<S: TexelSink>(&self, queries: &[Query], out: &mut [[f32; 4]], sink: &mut S) {
+        match &self.chain.store {
+            Store::Rgba8(c) => self.run_on(c, queries, out, sink),
+            Store::F32(c) => self.run_on(c, queries, out, sink),
+        }
+    }
+
+    fn run_on<P: Pixel, S: TexelSink>(
+        &self,
+        c: &Chain<P>,
+        queries: &[Query],
+        out: &mut [[f32; 4]],
+        sink: &mut S,
+    ) {
+        let (a, lod, o) = (&self.addr, &self.lod, &self.options);
         match self.kernel {
-            Kernel::Isotropic => {
-                let l = &levels[0];
-                let lambda = footprint::isotropic_lambda(q, l.wf, l.hf, &self.options);
-                trilinear::isotropic(levels, self.iso, &self.addr, u, v, lambda, sink)
-            }
-            Kernel::Texel => {
-                let l = &levels[0];
-                let fp = footprint(q, l.w, l.h, &self.options);
-                aniso::anisotropic(levels, self.iso, &self.addr, u, v, &fp, sink)
-            }
-            Kernel::Ewa => {
-                let (dx, dy) = footprint::derivatives(q, levels[0].wf, levels[0].hf);
-                ewa::ewa(
-                    levels,
-                    &self.addr,
-                    self.options.mip,
-                    self.options.max_aniso,
-                    &self.options,
-                    u,
-                    v,
-                    dx,
-                    dy,
-                    sink,
-                )
-            }
+            Kernel::Isotropic => self.run_filters::<P, S, false>(c, queries, out, sink),
+            Kernel::Texel => self.run_filters::<P, S, true>(c, queries, out, sink),
+            Kernel::Ewa => each(queries, out, |q| ewa::ewa(c, a, lod, o, q, sink)),
+            Kernel::Supersample => each(queries, out, |q| {
+                supersample::supersample(c, a, lod, o, q, sink)
+            }),
             // The table answers from four corner entries per rectangle, not
             // from texels, so nothing is reported to the sink.
-            Kernel::Sat => match &self.sat {
+            Kernel::Sat => each(queries, out, |q| match &self.sat {
                 Some(t) => t.sample(q.u, q.v, q.dudx, q.dvdx, q.dudy, q.dvdy),
                 None => [0.0; 4],
-            },
-            Kernel::Supersample => {
-                let (dx, dy) = footprint::derivatives(q, levels[0].wf, levels[0].hf);
-                supersample::supersample(
-                    levels,
-                    &self.addr,
-                    self.options.supersample,
-                    u,
-                    v,
-                    dx,
-                    dy,
-                    sink,
-                )
+            }),
+        }
+    }
+
+    fn run_filters<P: Pixel, S: TexelSink, const ANISO: bool>(
+        &self,
+        c: &Chain<P>,
+        queries: &[Query],
+        out: &mut [[f32; 4]],
+        sink: &mut S,
+    ) {
+        use TexelFilter::{Linear, Nearest};
+        match (self.options.mag, self.options.min) {
+            (Nearest, Nearest) => self.run_mip::<P, S, Near, ANISO>(c, Near, queries, out, sink),
+            (Linear, Linear) => self.run_mip::<P, S, Lin, ANISO>(c, Lin, queries, out, sink),
+            (mag, min) => {
+                let f = MagMin { mag, min };
+                self.run_mip::<P, S, MagMin, ANISO>(c, f, queries, out, sink)
             }
         }
+    }
+
+    fn run_mip<P: Pixel, S: TexelSink, F: Filters, const ANISO: bool>(
+        &self,
+        c: &Chain<P>,
+        f: F,
+        queries: &[Query],
+        out: &mut [[f32; 4]],
+        sink: &mut S,
+    ) {
+        use trilinear::{MIP_LINEAR, MIP_NEAREST, MIP_NONE};
+        match self.options.mip {
+            MipMode::None => self.run_texel::<P, S, F, MIP_NONE, ANISO>(c, f, queries, out, sink),
+            MipMode::Nearest => {
+                self.run_texel::<P, S, F, MIP_NEAREST, ANISO>(c, f, queries, out, sink)
+            }
+            MipMode::Linear => {
+                self.run_texel::<P, S, F, MIP_LINEAR, ANISO>(c, f, queries, out, sink)
+            }
+        }
+    }
+
+    fn run_texel<P: Pixel, S: TexelSink, F: Filters, const MIP: u8, const ANISO: bool>(
+        &self,
+        c: &Chain<P>,
+        f: F,
+        queries: &[Query],
+        out: &mut [[f32; 4]],
+        sink: &mut S,
+    ) {
+        let (a, lod, o) = (&self.addr, &self.lod, &self.options);
+        // Two passes per block of queries: first every footprint (LOD,
+        // levels, probe count), then every texel read. A lookup is one long
+        // chain of dependent steps (derivatives → λ → level → position →
+        // texel → decode); splitting it lets the processor overlap the
+        // arithmetic of one pass's independent queries instead of waiting
+        // on each chain in turn.
+        for (qs, os) in queries.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+            if ANISO {
+                let mut st = [aniso::Setup::EMPTY; BLOCK];
+                for (s, q) in st.iter_mut().zip(qs) {
+                    *s = aniso::setup::<F, MIP>(lod, o, q);
+                }
+                for (s, o) in st.iter().zip(os.iter_mut()) {
+                    *o = aniso::anisotropic(c, f, s, a, sink);
+                }
+            } else {
+                let mut plans = [footprint::Plan::MAGNIFY; BLOCK];
+                for (p, q) in plans.iter_mut().zip(qs) {
+                    *p = trilinear::plan::<F, MIP>(lod, o, q);
+                }
+                for ((p, q), o) in plans.iter().zip(qs).zip(os.iter_mut()) {
+                    *o = trilinear::probe(c, f, p, q.u as f64, q.v as f64, a, sink);
+                }
+            }
+        }
+    }
+}
+
+/// Queries per block of the two-pass loop (see `Sampler::run_texel`).
+const BLOCK: usize = 16;
+
+/// `out[i] = f(&queries[i])`.
+#[inline(always)]
+fn each(queries: &[Query], out: &mut [[f32; 4]], mut f: impl FnMut(&Query) -> [f32; 4]) {
+    for (q, o) in queries.iter().zip(out.iter_mut()) {
+        *o = f(q);
     }
 }
 
@@ -643,10 +735,4 @@ fn sat_unavailable() -> Error {
          use Sampler::new"
             .into(),
     )
-}
-
-/// A query coordinate as `f64`, NaN read as 0.
-#[inline(always)]
-fn coord(x: f32) -> f64 {
-    if x.is_nan() { 0.0 } else { x as f64 }
 }

@@ -13,22 +13,23 @@
 //! Cost is n² bilinear lookups whatever the footprint (n ≤ 64).
 
 use super::bilinear::bilinear;
-use super::fetch::{Addressing, Level};
+use super::fetch::{Addressing, Chain, Pixel};
+use super::footprint::{Lod, derivatives};
 use super::trace::TexelSink;
+use super::{Query, SamplerOptions};
 
-/// Supersampled lookup with `n × n` positions.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn supersample<S: TexelSink>(
-    levels: &[Level],
+/// Supersampled lookup of `q` with `n × n` positions.
+pub(crate) fn supersample<P: Pixel, S: TexelSink>(
+    c: &Chain<P>,
     a: &Addressing,
-    n: u32,
-    u: f64,
-    v: f64,
-    dx: [f64; 2],
-    dy: [f64; 2],
+    lod: &Lod,
+    o: &SamplerOptions,
+    q: &Query,
     sink: &mut S,
 ) -> [f32; 4] {
-    let n = n.clamp(1, 64);
+    let (u, v) = lod.reduce(q);
+    let (dx, dy) = derivatives(q, lod.wf, lod.hf);
+    let n = o.supersample.clamp(1, 64);
     let inv = 1.0 / n as f64;
     let mut acc = [0.0f64; 4];
     for j in 0..n {
@@ -37,7 +38,7 @@ pub(crate) fn supersample<S: TexelSink>(
             let tx = (i as f64 + 0.5) * inv - 0.5;
             let pu = u + tx * dx[0] + ty * dy[0];
             let pv = v + tx * dx[1] + ty * dy[1];
-            let t = bilinear(&levels[0], 0, pu, pv, a, sink);
+            let t = bilinear(c, 0, pu, pv, a, sink);
             for c in 0..4 {
                 acc[c] += t[c] as f64;
             }

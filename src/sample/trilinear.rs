@@ -1,5 +1,5 @@
-//! The isotropic lookup at a given λ: magnification, the six
-//! minification/mip combinations, trilinear (SPEC.md "Level of detail").
+//! The isotropic lookup: magnification, the six minification/mip
+//! combinations, trilinear (SPEC.md "Level of detail").
 //!
 //! - λ ≤ 0: the magnification filter on level 0.
 //! - λ > 0: the minification filter on the level(s) the mip mode selects:
@@ -8,43 +8,70 @@
 //!   has weight 0 and is not read (so not traced).
 //!
 //! Trilinear is `min = mag = linear, mip = linear`: 8 texel reads.
+//!
+//! A lookup is split in two: a [`Plan`] (which filter, which levels, what
+//! blend) made once per query, and [`probe`], which carries it out at a
+//! position. Footprint assembly makes one plan and runs up to 16 probes
+//! with it. The mip mode is a const parameter and the filters a type
+//! ([`Filters`]), so each combination compiles to its own loop: the
+//! nearest-mip path never takes a logarithm ([`Lod::plan_nearest`]), and
+//! `mip = none` with equal filters never looks at the derivatives.
 
-use super::bilinear::texel_filter;
-use super::fetch::{Addressing, Level, lerp};
-use super::footprint::levels_for;
+use super::bilinear::Filters;
+use super::fetch::{Addressing, Chain, Pixel, lerp};
+use super::footprint::{Lod, Plan};
 use super::trace::TexelSink;
-use super::{MipMode, TexelFilter};
+use super::{MipMode, Query, SamplerOptions};
 
-/// The parts of the options an isotropic lookup needs.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Iso {
-    pub mag: TexelFilter,
-    pub min: TexelFilter,
-    pub mip: MipMode,
+/// Mip mode `none` as a const parameter.
+pub(crate) const MIP_NONE: u8 = 0;
+/// Mip mode `nearest` as a const parameter.
+pub(crate) const MIP_NEAREST: u8 = 1;
+/// Mip mode `linear` as a const parameter.
+pub(crate) const MIP_LINEAR: u8 = 2;
+
+/// The [`MipMode`] of a const parameter.
+#[inline(always)]
+pub(crate) const fn mip_mode(m: u8) -> MipMode {
+    match m {
+        MIP_NONE => MipMode::None,
+        MIP_NEAREST => MipMode::Nearest,
+        _ => MipMode::Linear,
+    }
 }
 
-/// Isotropic lookup of `(u, v)` at λ.
+/// Carry out `plan` at `(u, v)`.
 #[inline(always)]
-pub(crate) fn isotropic<S: TexelSink>(
-    levels: &[Level],
-    o: Iso,
-    a: &Addressing,
+pub(crate) fn probe<P: Pixel, S: TexelSink, F: Filters>(
+    c: &Chain<P>,
+    f: F,
+    plan: &Plan,
     u: f64,
     v: f64,
-    lambda: f32,
+    a: &Addressing,
     sink: &mut S,
 ) -> [f32; 4] {
-    // λ is never NaN (see footprint); the guard costs nothing.
-    if lambda <= 0.0 || lambda.is_nan() {
-        return texel_filter(o.mag, &levels[0], 0, u, v, a, sink);
-    }
-    let q = levels.len() - 1;
-    let (hi, lo, delta) = levels_for(lambda, q, o.mip);
-    let t = texel_filter(o.min, &levels[hi], hi as u32, u, v, a, sink);
-    if delta > 0.0 && lo != hi {
-        let t2 = texel_filter(o.min, &levels[lo], lo as u32, u, v, a, sink);
-        lerp(t, t2, delta)
+    let t = f.run(plan.magnify, c, plan.hi, u, v, a, sink);
+    if plan.delta > 0.0 && plan.lo != plan.hi {
+        let t2 = f.run(false, c, plan.lo, u, v, a, sink);
+        lerp(t, t2, plan.delta)
     } else {
         t
+    }
+}
+
+/// The plan of an isotropic lookup of `q` (the first half of a lookup;
+/// [`probe`] at `(q.u, q.v)` is the second).
+///
+/// Coordinates are not reduced to the first wrap period: the per-level
+/// filters test whether the footprint is inside the level and wrap only
+/// when not.
+#[inline(always)]
+pub(crate) fn plan<F: Filters, const MIP: u8>(lod: &Lod, o: &SamplerOptions, q: &Query) -> Plan {
+    match MIP {
+        MIP_NONE if F::SAME => Plan::MAGNIFY,
+        MIP_NONE => lod.plan_level0(q),
+        MIP_NEAREST => lod.plan_nearest(q),
+        _ => Plan::at(lod.lambda(q, o), lod.q, MipMode::Linear),
     }
 }

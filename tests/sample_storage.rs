@@ -1,0 +1,214 @@
+//! The samplers' fast paths against their general ones: packed 8-bit
+//! storage (decoded at fetch) against the same levels decoded to `f32` up
+//! front, lookups inside a level against the same lookups whole wrap
+//! periods away, and the logarithm-free nearest-mip rule against SPEC's
+//! λ rule.
+
+use parvo::mip::MipChain;
+use parvo::sample::{
+    Filter, MipMode, Query, Sampler, SamplerOptions, TexelRecorder, footprint, mip_nearest,
+};
+use parvo::texel::{ChannelType, ColorSpace, Format};
+use parvo::{MipOptions, Texture, Wrap, WrapMode, mip};
+
+/// xorshift64*, fixed seeds.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+    fn f(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+fn presets() -> Vec<SamplerOptions> {
+    let mut v: Vec<SamplerOptions> = [
+        Filter::Nearest,
+        Filter::Bilinear,
+        Filter::Trilinear,
+        Filter::Ewa,
+        Filter::Supersample,
+    ]
+    .into_iter()
+    .map(|f| SamplerOptions::preset(f, 8))
+    .collect();
+    v.push(SamplerOptions::aniso(4));
+    v.push(SamplerOptions::aniso(16));
+    v.push(SamplerOptions {
+        mag: parvo::sample::TexelFilter::Nearest,
+        mip: MipMode::None,
+        ..SamplerOptions::trilinear()
+    });
+    v
+}
+
+fn query(r: &mut Rng) -> Query {
+    let d = |r: &mut Rng, s: f32| (r.f() - 0.5) * s;
+    Query::new(
+        r.f() * 3.0 - 1.0,
+        r.f() * 3.0 - 1.0,
+        d(r, 0.3),
+        d(r, 0.05),
+        d(r, 0.05),
+        d(r, 0.2),
+    )
+}
+
+#[test]
+fn packed_8bit_storage_samples_like_the_levels_decoded_to_f32() {
+    let modes = [
+        WrapMode::Repeat,
+        WrapMode::MirroredRepeat,
+        WrapMode::ClampToEdge,
+        WrapMode::ClampToBorder,
+    ];
+    for ch in 1u8..=4 {
+        for cs in [ColorSpace::Srgb, ColorSpace::Linear] {
+            let f = Format::new(ch, ChannelType::U8, cs);
+            let mut r = Rng(ch as u64 * 7 + cs as u64);
+            let v: Vec<u8> = (0..37 * 23 * ch as usize).map(|_| r.next() as u8).collect();
+            let packed = mip::build(
+                Texture::from_u8(37, 23, f, v).unwrap(),
+                &MipOptions::default(),
+            )
+            .unwrap();
+            // The same levels, decoded once to linear f32.
+            let lin = Format::new(ch, ChannelType::F32, ColorSpace::Linear);
+            let decoded = MipChain::from_levels(
+                packed
+                    .levels()
+                    .iter()
+                    .map(|t| t.convert(lin).unwrap())
+                    .collect(),
+                MipOptions::default(),
+            )
+            .unwrap();
+            for base in presets() {
+                for (i, &m) in modes.iter().enumerate() {
+                    let o = SamplerOptions {
+                        wrap: Wrap {
+                            u: m,
+                            v: modes[(i + 1) % modes.len()],
+                        },
+                        border: [0.1, 0.2, 0.3, 0.4],
+                        ..base
+                    };
+                    let a = Sampler::new(&packed, o).unwrap();
+                    let b = Sampler::new(&decoded, o).unwrap();
+                    for _ in 0..60 {
+                        let q = query(&mut r);
+                        let (x, y) = (a.sample(&q), b.sample(&q));
+                        assert!(
+                            x.iter().zip(&y).all(|(p, q)| (p - q).abs() <= 1e-6),
+                            "{ch} ch {cs:?} {} {m}: {x:?} vs {y:?} at {q:?}",
+                            o.name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn lookups_whole_wrap_periods_apart_are_identical() {
+    // u = m/64 + k is exact in f32 for |k| < 2^17, so the texel-space
+    // positions differ by whole periods exactly: the in-level fast path and
+    // the wrapping path must give the same bits.
+    let f = Format::new(4, ChannelType::U8, ColorSpace::Srgb);
+    let mut r = Rng(41);
+    let v: Vec<u8> = (0..64 * 32 * 4).map(|_| r.next() as u8).collect();
+    let chain = mip::build(
+        Texture::from_u8(64, 32, f, v).unwrap(),
+        &MipOptions::default(),
+    )
+    .unwrap();
+    for (mode, period) in [(WrapMode::Repeat, 1i32), (WrapMode::MirroredRepeat, 2)] {
+        for base in presets() {
+            let o = SamplerOptions {
+                wrap: Wrap::both(mode),
+                ..base
+            };
+            let s = Sampler::new(&chain, o).unwrap();
+            for _ in 0..200 {
+                let (m, n) = ((r.next() % 64) as f32, (r.next() % 64) as f32);
+                let q = query(&mut r).at(m / 64.0, n / 64.0);
+                let mut want_reads = TexelRecorder::new();
+                let want = s.sample_traced(&q, &mut want_reads);
+                for k in [-1000, -3, -1, 1, 2, 7, 12345] {
+                    let k = (k * period) as f32;
+                    let moved = q.at(q.u + k, q.v - k);
+                    let mut reads = TexelRecorder::new();
+                    let got = s.sample_traced(&moved, &mut reads);
+                    assert_eq!(got, want, "{} {mode} {q:?} moved by {k}", o.name());
+                    assert_eq!(reads.reads, want_reads.reads, "{} {mode}", o.name());
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn nearest_mip_level_matches_the_lambda_rule_for_random_footprints() {
+    // SPEC: λ = clamp(log2(ρmax) + bias), d = ceil(clamp(λ, 0, q) + 0.5) − 1,
+    // magnification when λ ≤ 0. The sampler picks the level without a
+    // logarithm; away from the rounding thresholds it must agree.
+    let (w, h) = (512u32, 128u32);
+    let n = mip::level_count(w, h, mip::Rounding::Down, None) as usize;
+    let levels: Vec<Texture> = (0..n)
+        .map(|k| {
+            let (lw, lh) = mip::level_size(w, h, k as u32, mip::Rounding::Down);
+            let f = Format::new(1, ChannelType::F32, ColorSpace::Linear);
+            Texture::from_f32(lw, lh, f, vec![k as f32; (lw * lh) as usize]).unwrap()
+        })
+        .collect();
+    let chain = MipChain::from_levels(levels, MipOptions::default()).unwrap();
+    let mut r = Rng(5);
+    let mut checked = 0;
+    for _ in 0..4000 {
+        let bias = [0.0, 0.5, -1.25, 2.0, (r.f() - 0.5) * 6.0][(r.next() % 5) as usize];
+        let (lod_min, lod_max) = match r.next() % 3 {
+            0 => (-1000.0, 1000.0),
+            1 => (1.5, 3.0),
+            _ => (-2.0, 0.75),
+        };
+        let o = SamplerOptions {
+            lod_bias: bias,
+            lod_min,
+            lod_max,
+            ..SamplerOptions::nearest()
+        };
+        let s = Sampler::new(&chain, o).unwrap();
+        // Derivative lengths from 2^-4 to 2^12 texels.
+        let len = 2f32.powf(r.f() * 16.0 - 4.0);
+        let ang = r.f() * std::f32::consts::TAU;
+        let q = Query::new(
+            0.37,
+            0.61,
+            len * ang.cos() / w as f32,
+            len * ang.sin() / h as f32,
+            -0.3 * len * ang.sin() / w as f32,
+            0.3 * len * ang.cos() / h as f32,
+        );
+        let lambda = footprint(&q, w, h, &o).lambda;
+        let frac = (lambda - lambda.floor() - 0.5).abs();
+        if lambda.abs() < 1e-4 || frac < 1e-4 {
+            continue; // on a threshold: either side is a correct rounding
+        }
+        let want = if lambda <= 0.0 {
+            0
+        } else {
+            mip_nearest(lambda, n - 1)
+        };
+        let mut rec = TexelRecorder::new();
+        let got = s.sample_traced(&q, &mut rec)[0];
+        assert_eq!(got, want as f32, "λ = {lambda}, bias {bias}");
+        assert!(rec.reads.iter().all(|t| t.level as usize == want));
+        checked += 1;
+    }
+    assert!(checked > 3500, "{checked}");
+}
