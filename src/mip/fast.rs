@@ -356,32 +356,7 @@ fn row_u8_srgb(r0: &[u8], r1: &[u8], dst: &mut [u8], fmt: Format, t: &FixedSrgb)
         1 => row_u8_srgb_n::<1, 1>(r0, r1, dst, t),
         2 => row_u8_srgb_n::<2, 1>(r0, r1, dst, t),
         3 => row_u8_srgb_n::<3, 3>(r0, r1, dst, t),
-        _ => row_rgba8_srgb(r0, r1, dst, t),
-    }
-}
-
-/// RGBA8 sRGB: one 8-byte load per row and texel pair, bytes taken out by
-/// shifts, one 4-byte store (fewer load slots than byte loads: the table
-/// look-ups are what the loop is bound by).
-#[inline(always)]
-fn row_rgba8_srgb(r0: &[u8], r1: &[u8], dst: &mut [u8], t: &FixedSrgb) {
-    let dec = &t.dec;
-    let word = |s: &[u8]| u64::from_le_bytes(s.try_into().expect("8 bytes"));
-    for ((d, a), b) in dst
-        .chunks_exact_mut(4)
-        .zip(r0.chunks_exact(8))
-        .zip(r1.chunks_exact(8))
-    {
-        let (a, b) = (word(a), word(b));
-        let byte = |v: u64, k: u32| (v >> (8 * k)) as u8 as usize;
-        let mut out = 0u32;
-        for c in 0..3 {
-            let s = dec[byte(a, c)] + dec[byte(a, c + 4)] + dec[byte(b, c)] + dec[byte(b, c + 4)];
-            out |= (t.encode4(s) as u32) << (8 * c);
-        }
-        let alpha = (a >> 24 & 0xFF) + (a >> 56) + (b >> 24 & 0xFF) + (b >> 56);
-        out |= (((alpha + 2) >> 2) as u32) << 24;
-        d.copy_from_slice(&out.to_le_bytes());
+        _ => row_u8_srgb_n::<4, 3>(r0, r1, dst, t),
     }
 }
 
@@ -592,39 +567,6 @@ fn row_f32_straight(r0: &[f32], r1: &[f32], dst: &mut [f32], ch: usize, a: usize
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The word-wise RGBA8 sRGB kernel gives the same bytes as the
-    /// generic per-channel kernel, on random rows and on rows that hold
-    /// every byte value in every channel.
-    #[test]
-    fn rgba8_srgb_rows_equal_generic_rows() {
-        let t = fixed_tables();
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rows: Vec<(Vec<u8>, Vec<u8>)> = Vec::new();
-        for texels in [2usize, 10, 66, 1002] {
-            let mut row = || {
-                (0..texels * 4)
-                    .map(|_| {
-                        seed ^= seed << 13;
-                        seed ^= seed >> 7;
-                        seed ^= seed << 17;
-                        (seed >> 56) as u8
-                    })
-                    .collect::<Vec<u8>>()
-            };
-            rows.push((row(), row()));
-        }
-        let all: Vec<u8> = (0..=255u8).flat_map(|v| [v, 255 - v, v / 3, v]).collect();
-        let rev: Vec<u8> = all.iter().rev().copied().collect();
-        rows.push((all, rev));
-        for (r0, r1) in rows {
-            let mut want = vec![0u8; r0.len() / 2];
-            row_u8_srgb_n::<4, 3>(&r0, &r1, &mut want, t);
-            let mut got = vec![0u8; r0.len() / 2];
-            row_rgba8_srgb(&r0, &r1, &mut got, t);
-            assert_eq!(got, want, "row of {} texels", r0.len() / 4);
-        }
-    }
 
     #[test]
     fn one_step_encode_equals_the_threshold_count_everywhere() {
