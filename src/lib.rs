@@ -7,7 +7,7 @@
 //!                      │ mip::build(MipOptions)
 //!                      ▼
 //!                   MipChain (levels in the source format)
-//!                      │ sample::Sampler::new(SamplerOptions): decode to linear RGBA f32
+//!                      │ sample::Sampler::new(SamplerOptions): 8-bit kept packed, others to linear RGBA f32
 //!                      ▼
 //! Query{uv, derivatives} ──▶ Footprint (λ, η) ──▶ filter ──▶ [f32; 4]
 //!                                                   └──▶ TexelSink (every texel read)
