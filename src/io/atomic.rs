@@ -119,21 +119,30 @@ where
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let tmp = tempfile::Builder::new()
-        .prefix(".parvo-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| Error::Io {
-            path: dir.to_path_buf(),
-            action: format!("cannot create a file in {}", dir.display()),
-            // tempfile appends the random temporary name; keep only the
-            // operating system's reason.
-            error: {
-                let msg = e.to_string();
-                let reason = msg.split(" at path ").next().unwrap_or(&msg).to_string();
-                std::io::Error::new(e.kind(), reason)
-            },
-        })?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".parvo-").suffix(".tmp");
+    // Temporary files are created owner-only (0600); the finished file
+    // should get what any new file gets (0666 less the umask).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let tmp = builder.tempfile_in(dir).map_err(|e| Error::Io {
+        path: dir.to_path_buf(),
+        action: format!("cannot create a file in {}", dir.display()),
+        // tempfile appends the random temporary name; keep only the
+        // operating system's reason.
+        error: {
+            let msg = e.to_string();
+            let reason = msg.split(" at path ").next().unwrap_or(&msg).to_string();
+            std::io::Error::new(e.kind(), reason)
+        },
+    })?;
+    // Replacing a file keeps its permissions.
+    if let Ok(meta) = std::fs::metadata(dest) {
+        let _ = tmp.as_file().set_permissions(meta.permissions());
+    }
     let tmp = Tracked::new(tmp);
     let io_err = |e: std::io::Error| Error::Io {
         path: dest.to_path_buf(),
@@ -199,6 +208,25 @@ mod tests {
         })
         .unwrap();
         assert_eq!(std::fs::read(&dest).unwrap(), b"new");
+    }
+
+    /// A new file gets the permissions any newly created file gets here
+    /// (not the temporary file's owner-only 0600); a replaced file keeps
+    /// its own.
+    #[test]
+    #[cfg(unix)]
+    fn written_files_get_ordinary_or_kept_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain.bin");
+        std::fs::write(&plain, b"x").unwrap();
+        let dest = dir.path().join("out.bin");
+        write(&dest, |w| Ok(w.write_all(b"new").unwrap())).unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&dest), mode(&plain));
+        std::fs::set_permissions(&dest, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write(&dest, |w| Ok(w.write_all(b"newer").unwrap())).unwrap();
+        assert_eq!(mode(&dest), 0o640);
     }
 
     #[test]
