@@ -221,11 +221,19 @@ mod tests {
         let plain = dir.path().join("plain.bin");
         std::fs::write(&plain, b"x").unwrap();
         let dest = dir.path().join("out.bin");
-        write(&dest, |w| Ok(w.write_all(b"new").unwrap())).unwrap();
+        write(&dest, |w| {
+            w.write_all(b"new").unwrap();
+            Ok(())
+        })
+        .unwrap();
         let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode(&dest), mode(&plain));
         std::fs::set_permissions(&dest, std::fs::Permissions::from_mode(0o640)).unwrap();
-        write(&dest, |w| Ok(w.write_all(b"newer").unwrap())).unwrap();
+        write(&dest, |w| {
+            w.write_all(b"newer").unwrap();
+            Ok(())
+        })
+        .unwrap();
         assert_eq!(mode(&dest), 0o640);
     }
 
