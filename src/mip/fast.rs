@@ -6,8 +6,9 @@
 //!   which vectorises), the horizontal pairs are summed from it.
 //! - u8, sRGB: colour channels through a 256-entry decode table in 2^-24
 //!   fixed point, summed in u32, and encoded by comparing against the exact
-//!   sRGB decision thresholds (a 4 Ki-bucket index, small enough for the
-//!   L1 cache, gives the candidate code; one comparison settles it). No `powf` per texel, and the result
+//!   sRGB decision thresholds (one look-up in a 4 Ki-bucket table, small
+//!   enough for the L1 cache, gives the candidate code and the threshold
+//!   inside the bucket; one comparison settles it). No `powf` per texel, and the result
 //!   is the correctly rounded code except within ~1e-3 of a code of a tie.
 //! - f32, linear: one fused pass reading the 2×2 block, no decode copy; for
 //!   RGBA each texel is one SSE register, and the same pass notes whether
@@ -301,17 +302,22 @@ mod simd {
 /// units (a sum of four decoded values), and the bucket index.
 pub(crate) struct FixedSrgb {
     dec: [u32; 256],
+    /// The decision thresholds themselves, kept for the exhaustive test.
+    #[cfg(test)]
     thr: [u32; 256],
     /// Indexed by `s >> BUCKET_SHIFT` masked to the table size (so no
     /// bounds check); sums reach at most bucket 4096, the rest is padding.
-    bucket: Box<[u8; BUCKETS]>,
+    /// Each entry packs the code at the bucket's start (low 8 bits) and
+    /// the offset within the bucket of the one threshold it may hold
+    /// (2^14 when it holds none), so encoding is one look-up.
+    bucket: Box<[u32; BUCKETS]>,
 }
 
 const BUCKETS: usize = 8192;
 
 /// Bucket width 2^14 units: below the smallest threshold spacing (20369
 /// units, in the linear segment near black), so a bucket holds at most one
-/// threshold; 4097 one-byte buckets stay in the L1 cache.
+/// threshold; the 4097 buckets in use (16 KiB) stay in the L1 cache.
 const BUCKET_SHIFT: u32 = 14;
 
 fn fixed_tables() -> &'static FixedSrgb {
@@ -325,16 +331,26 @@ fn fixed_tables() -> &'static FixedSrgb {
         for (k, t) in thr.iter_mut().enumerate().take(255) {
             *t = (srgb::decode_f64((k as f64 + 0.5) / 255.0) * (1u64 << 26) as f64).ceil() as u32;
         }
-        let mut bucket = Box::new([0u8; BUCKETS]);
+        let mut bucket = Box::new([0u32; BUCKETS]);
         let mut code = 0usize;
         for (b, slot) in bucket.iter_mut().enumerate() {
             let lo = (b as u32) << BUCKET_SHIFT;
             while code < 255 && lo >= thr[code] {
                 code += 1;
             }
-            *slot = code as u8;
+            // thr[code] > lo here; it lies in this bucket if below the next.
+            let offset = match thr[code].checked_sub(lo) {
+                Some(o) if o < 1 << BUCKET_SHIFT => o,
+                _ => 1 << BUCKET_SHIFT,
+            };
+            *slot = code as u32 | offset << 8;
         }
-        FixedSrgb { dec, thr, bucket }
+        FixedSrgb {
+            dec,
+            #[cfg(test)]
+            thr,
+            bucket,
+        }
     })
 }
 
@@ -346,8 +362,9 @@ impl FixedSrgb {
     /// at most one below the answer: one comparison, no loop.
     #[inline(always)]
     fn encode4(&self, s: u32) -> u8 {
-        let c = self.bucket[(s >> BUCKET_SHIFT) as usize & (BUCKETS - 1)];
-        c + u8::from(s >= self.thr[c as usize])
+        let e = self.bucket[(s >> BUCKET_SHIFT) as usize & (BUCKETS - 1)];
+        let within = s & ((1 << BUCKET_SHIFT) - 1);
+        e as u8 + u8::from(within >= e >> 8)
     }
 }
 
