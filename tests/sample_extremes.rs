@@ -5,7 +5,7 @@
 
 use parvo::sample::ewa::MAX_RADIUS;
 use parvo::sample::{
-    Filter, LinearChain, MipMode, Query, Sampler, SamplerOptions, TexelCounter, TexelRecorder,
+    LinearChain, MipMode, Query, Sampler, SamplerOptions, TexelCounter, TexelRecorder,
 };
 use parvo::texel::{ChannelType, ColorSpace, Format};
 use parvo::{MipChain, MipOptions, Texture, Wrap, WrapMode, mip};
@@ -29,20 +29,10 @@ fn chain(t: Texture) -> MipChain {
     mip::build(t, &MipOptions::default()).unwrap()
 }
 
+mod common;
+
 fn presets() -> Vec<SamplerOptions> {
-    let mut v: Vec<SamplerOptions> = [
-        Filter::Nearest,
-        Filter::Bilinear,
-        Filter::Trilinear,
-        Filter::Ewa,
-        Filter::Supersample,
-    ]
-    .into_iter()
-    .map(|f| SamplerOptions::preset(f, 16))
-    .collect();
-    v.push(SamplerOptions::aniso(4));
-    v.push(SamplerOptions::aniso(16));
-    v
+    common::sampler_presets(16)
 }
 
 const HUGE: [f32; 5] = [1e30, -1e30, f32::MAX, f32::INFINITY, f32::NAN];

@@ -6,38 +6,16 @@
 
 use parvo::mip::MipChain;
 use parvo::sample::{
-    Filter, MipMode, Query, Sampler, SamplerOptions, TexelRecorder, footprint, mip_nearest,
+    MipMode, Query, Sampler, SamplerOptions, TexelRecorder, footprint, mip_nearest,
 };
 use parvo::texel::{ChannelType, ColorSpace, Format};
 use parvo::{MipOptions, Texture, Wrap, WrapMode, mip};
 
-/// xorshift64*, fixed seeds.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn f(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+mod common;
+use common::Rng;
 
 fn presets() -> Vec<SamplerOptions> {
-    let mut v: Vec<SamplerOptions> = [
-        Filter::Nearest,
-        Filter::Bilinear,
-        Filter::Trilinear,
-        Filter::Ewa,
-        Filter::Supersample,
-    ]
-    .into_iter()
-    .map(|f| SamplerOptions::preset(f, 8))
-    .collect();
-    v.push(SamplerOptions::aniso(4));
-    v.push(SamplerOptions::aniso(16));
+    let mut v = common::sampler_presets(8);
     v.push(SamplerOptions {
         mag: parvo::sample::TexelFilter::Nearest,
         mip: MipMode::None,
@@ -70,7 +48,9 @@ fn packed_8bit_storage_samples_like_the_levels_decoded_to_f32() {
         for cs in [ColorSpace::Srgb, ColorSpace::Linear] {
             let f = Format::new(ch, ChannelType::U8, cs);
             let mut r = Rng(ch as u64 * 7 + cs as u64);
-            let v: Vec<u8> = (0..37 * 23 * ch as usize).map(|_| r.next() as u8).collect();
+            let v: Vec<u8> = (0..37 * 23 * ch as usize)
+                .map(|_| r.next_u64() as u8)
+                .collect();
             let packed = mip::build(
                 Texture::from_u8(37, 23, f, v).unwrap(),
                 &MipOptions::default(),
@@ -121,7 +101,7 @@ fn lookups_whole_wrap_periods_apart_are_identical() {
     // the wrapping path must give the same bits.
     let f = Format::new(4, ChannelType::U8, ColorSpace::Srgb);
     let mut r = Rng(41);
-    let v: Vec<u8> = (0..64 * 32 * 4).map(|_| r.next() as u8).collect();
+    let v: Vec<u8> = (0..64 * 32 * 4).map(|_| r.next_u64() as u8).collect();
     let chain = mip::build(
         Texture::from_u8(64, 32, f, v).unwrap(),
         &MipOptions::default(),
@@ -135,7 +115,7 @@ fn lookups_whole_wrap_periods_apart_are_identical() {
             };
             let s = Sampler::new(&chain, o).unwrap();
             for _ in 0..200 {
-                let (m, n) = ((r.next() % 64) as f32, (r.next() % 64) as f32);
+                let (m, n) = ((r.next_u64() % 64) as f32, (r.next_u64() % 64) as f32);
                 let q = query(&mut r).at(m / 64.0, n / 64.0);
                 let mut want_reads = TexelRecorder::new();
                 let want = s.sample_traced(&q, &mut want_reads);
@@ -170,8 +150,8 @@ fn nearest_mip_level_matches_the_lambda_rule_for_random_footprints() {
     let mut r = Rng(5);
     let mut checked = 0;
     for _ in 0..4000 {
-        let bias = [0.0, 0.5, -1.25, 2.0, (r.f() - 0.5) * 6.0][(r.next() % 5) as usize];
-        let (lod_min, lod_max) = match r.next() % 3 {
+        let bias = [0.0, 0.5, -1.25, 2.0, (r.f() - 0.5) * 6.0][(r.next_u64() % 5) as usize];
+        let (lod_min, lod_max) = match r.next_u64() % 3 {
             0 => (-1000.0, 1000.0),
             1 => (1.5, 3.0),
             _ => (-2.0, 0.75),

@@ -19,6 +19,30 @@ impl Rng {
     pub fn unit(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
+    /// Uniform in [0, 1) as f32.
+    pub fn f(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// Every sampling filter preset (anisotropic ones at 4 and 16; the other
+/// presets built with `max_aniso`), for tests that run a property over all
+/// of them.
+pub fn sampler_presets(max_aniso: u32) -> Vec<parvo::sample::SamplerOptions> {
+    use parvo::sample::{Filter, SamplerOptions};
+    let mut v: Vec<SamplerOptions> = [
+        Filter::Nearest,
+        Filter::Bilinear,
+        Filter::Trilinear,
+        Filter::Ewa,
+        Filter::Supersample,
+    ]
+    .into_iter()
+    .map(|f| SamplerOptions::preset(f, max_aniso))
+    .collect();
+    v.push(SamplerOptions::aniso(4));
+    v.push(SamplerOptions::aniso(16));
+    v
 }
 
 pub const AWKWARD: [(u32, u32); 6] = [(1, 1), (1, 9), (9, 1), (3, 5), (12, 19), (257, 129)];
