@@ -30,11 +30,11 @@ use super::{Query, SamplerOptions};
 /// first wrap period) and the longer derivative vector.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Setup {
-    plan: Plan,
-    probes: u32,
-    u: f64,
-    v: f64,
-    major: [f64; 2],
+    pub plan: Plan,
+    pub probes: u32,
+    pub u: f64,
+    pub v: f64,
+    pub major: [f64; 2],
 }
 
 impl Setup {

@@ -84,6 +84,8 @@ pub(crate) trait Filters: Copy {
     /// True when magnification and minification use the same filter, so
     /// the λ ≤ 0 test changes nothing but the level (level 0).
     const SAME: bool;
+    /// True for [`Lin`] (bilinear for both), which has SIMD paths.
+    const LINEAR: bool = false;
     /// Run the magnification (`magnify`) or minification filter on level
     /// `li`.
     #[allow(clippy::too_many_arguments)]
@@ -133,6 +135,7 @@ impl Filters for Near {
 
 impl Filters for Lin {
     const SAME: bool = true;
+    const LINEAR: bool = true;
     #[inline(always)]
     fn run<P: Pixel, S: TexelSink>(
         self,

@@ -11,7 +11,9 @@
 //! - **8-bit chains** (any channel count, sRGB or linear) are kept packed,
 //!   one `[u8; 4]` per texel (grey replicated, missing alpha stored as
 //!   255), and decoded at fetch through a 256-entry table per channel
-//!   (4 KiB, in L1 next to the texels). The table is filled by the same
+//!   (4 KiB, in L1 next to the texels), plus the colour and alpha tables as
+//!   byte planes (2 KiB) for the SIMD paths, which look up 64 codes at a
+//!   time. The table is filled by the same
 //!   decoder the rest of the crate uses ([`crate::texel::decode_u8`] then
 //!   `expand_to_rgba`), so a fetch returns exactly what decoding the whole
 //!   chain up front would.
@@ -62,6 +64,10 @@ pub(crate) trait Pixel: Copy + Send + Sync + 'static {
     /// The linear-light RGBA value.
     fn decode(self, lut: &Self::Lut) -> [f32; 4];
 
+    /// The decode table of a packed texel, `None` for texels stored as
+    /// linear RGBA `f32` (the SIMD paths read either).
+    fn packed(lut: &Self::Lut) -> Option<&Lut8>;
+
     /// Bilinear blend of a 2×2 block `[t00, t10, t01, t11]` with fractions
     /// α (along x) and β (along y): `lerp(lerp(t00, t10, α), lerp(t01,
     /// t11, α), β)` in linear light.
@@ -81,12 +87,33 @@ impl Pixel for [f32; 4] {
     fn decode(self, _: &()) -> [f32; 4] {
         self
     }
+
+    #[inline(always)]
+    fn packed(_: &()) -> Option<&Lut8> {
+        None
+    }
 }
 
 /// Per-channel decode table of a packed 8-bit chain: `table[c][i]` is the
 /// linear value of code `i` in channel `c`.
 #[derive(Clone)]
-pub(crate) struct Lut8(Box<[[f32; 256]; 4]>);
+pub(crate) struct Lut8 {
+    table: Box<[[f32; 256]; 4]>,
+    /// The tables of channel 0 (colour) and channel 3 (alpha) as byte
+    /// planes: `planes[k][p][i]` is byte `p` (little-endian) of the `f32`
+    /// value of code `i`. The SIMD paths look up 64 codes at a time in
+    /// them (`simd`).
+    pub planes: Box<[[[u8; 256]; 4]; 2]>,
+    /// Channels 0, 1 and 2 share one table (true for every format: a
+    /// format has one colour space, and grey is replicated).
+    pub shared: bool,
+    /// The alpha table is the colour table too (linear formats).
+    pub alpha_same: bool,
+    /// The colour and the alpha table are `code as f32 * (1.0 / 255.0)`,
+    /// which the SIMD paths compute instead of looking up.
+    pub colour_linear: bool,
+    pub alpha_linear: bool,
+}
 
 impl fmt::Debug for Lut8 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -98,13 +125,18 @@ impl Pixel for [u8; 4] {
     type Lut = Lut8;
     #[inline(always)]
     fn decode(self, lut: &Lut8) -> [f32; 4] {
-        let t = &*lut.0;
+        let t = &*lut.table;
         [
             t[0][self[0] as usize],
             t[1][self[1] as usize],
             t[2][self[2] as usize],
             t[3][self[3] as usize],
         ]
+    }
+
+    #[inline(always)]
+    fn packed(lut: &Lut8) -> Option<&Lut8> {
+        Some(lut)
     }
 }
 
@@ -199,7 +231,25 @@ fn lut8(format: &Format) -> Lut8 {
             t[c][i] = x;
         }
     }
-    Lut8(t)
+    let mut planes = Box::new([[[0u8; 256]; 4]; 2]);
+    for (k, c) in [0, 3].into_iter().enumerate() {
+        for (i, x) in t[c].iter().enumerate() {
+            for (p, b) in x.to_le_bytes().into_iter().enumerate() {
+                planes[k][p][i] = b;
+            }
+        }
+    }
+    let same = |a: usize, b: usize| t[a].map(f32::to_bits) == t[b].map(f32::to_bits);
+    let linear =
+        |c: usize| (0..256).all(|i| t[c][i].to_bits() == (i as f32 * (1.0 / 255.0)).to_bits());
+    Lut8 {
+        shared: same(0, 1) && same(0, 2),
+        alpha_same: same(0, 3),
+        colour_linear: linear(0),
+        alpha_linear: linear(3),
+        planes,
+        table: t,
+    }
 }
 
 impl LinearChain {
@@ -269,7 +319,11 @@ impl LinearChain {
                 .sum()
         }
         match &self.store {
-            Store::Rgba8(c) => bytes(c) + std::mem::size_of_val(&*c.lut.0),
+            Store::Rgba8(c) => {
+                bytes(c)
+                    + std::mem::size_of_val(&*c.lut.table)
+                    + std::mem::size_of_val(&*c.lut.planes)
+            }
             Store::F32(c) => bytes(c),
         }
     }

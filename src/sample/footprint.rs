@@ -152,10 +152,10 @@ pub(crate) fn log2(x: f64) -> f64 {
     e + (a + f * (b - a))
 }
 
-const LOG2_BITS: u32 = 10;
+pub(crate) const LOG2_BITS: u32 = 10;
 
 /// log2(1 + i/1024), i = 0..=1024.
-static LOG2_TABLE: [f32; (1 << LOG2_BITS) + 1] = {
+pub(crate) static LOG2_TABLE: [f32; (1 << LOG2_BITS) + 1] = {
     let mut t = [0f32; (1 << LOG2_BITS) + 1];
     let mut i = 0;
     while i < t.len() {
@@ -307,10 +307,10 @@ pub(crate) struct Lod {
     /// Last level index.
     pub q: usize,
     /// 4^bias (clamped so that 0·4^bias stays 0 and ∞ stays ∞).
-    scale: f64,
+    pub scale: f64,
     /// 4^lodMin and 4^lodMax.
-    y_min: f64,
-    y_max: f64,
+    pub y_min: f64,
+    pub y_max: f64,
     /// Wrap modes, for [`Lod::reduce`].
     wrap_u: WrapMode,
     wrap_v: WrapMode,

@@ -19,6 +19,11 @@
 //!   lookups sharing one λ and one pair of levels.
 //! - [`trace`]: every filter is generic over a [`TexelSink`] that sees each
 //!   texel read; [`NoTrace`] compiles away.
+//! - `simd`: on x86-64 CPUs with AVX-512 (F, BW, DQ, VL, VBMI), untraced
+//!   bilinear, trilinear and footprint-assembly lookups run 8 queries (or
+//!   8 probes) per step in vector registers, with results identical bit
+//!   for bit to the portable code ([`Sampler::uses_simd`]; `PARVO_NO_AVX=1`
+//!   turns it off).
 //! - `batch`: slices of queries, serial or in parallel (rayon).
 //! - [`plane`]: perspective ground-plane queries, the scene the accuracy
 //!   tests, benchmarks and examples share.
@@ -80,6 +85,8 @@ pub mod fetch;
 pub mod footprint;
 pub mod plane;
 mod query;
+#[cfg(target_arch = "x86_64")]
+mod simd;
 mod supersample;
 pub mod trace;
 mod trilinear;
@@ -581,6 +588,32 @@ impl Sampler {
         })
     }
 
+    /// Whether lookups without a tracing sink take the AVX-512 path: the
+    /// bilinear, trilinear and footprint-assembly lookups (linear
+    /// magnification and minification, mip mode nearest or linear) on a
+    /// CPU with AVX-512 F, BW, DQ, VL and VBMI, unless `PARVO_NO_AVX` is
+    /// set. The results are the same either way, bit for bit; traced
+    /// lookups always take the portable path.
+    pub fn uses_simd(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use TexelFilter::Linear;
+            let o = &self.options;
+            let kernel = matches!(self.kernel, Kernel::Isotropic | Kernel::Texel);
+            let fits = match &self.chain.store {
+                Store::Rgba8(c) => simd::fits(c),
+                Store::F32(c) => simd::fits(c),
+            };
+            kernel
+                && (o.mag, o.min) == (Linear, Linear)
+                && o.mip != MipMode::None
+                && simd::available()
+                && fits
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        false
+    }
+
     /// The options.
     pub fn options(&self) -> &SamplerOptions {
         &self.options
@@ -690,6 +723,25 @@ impl Sampler {
         sink: &mut S,
     ) {
         let (a, lod, o) = (&self.addr, &self.lod, &self.options);
+        #[cfg(target_arch = "x86_64")]
+        if !S::TRACES
+            && F::LINEAR
+            && MIP != trilinear::MIP_NONE
+            && simd::available()
+            && simd::fits(c)
+        {
+            // SAFETY: `available` checked the CPU features and `fits` the
+            // chain, the two conditions of both functions.
+            #[allow(unsafe_code)]
+            unsafe {
+                if ANISO {
+                    simd::anisotropic::<P, MIP>(c, a, lod, o, queries, out);
+                } else {
+                    simd::isotropic::<P, MIP>(c, a, lod, o, queries, out);
+                }
+            }
+            return;
+        }
         // Two passes per block of queries: first every footprint (LOD,
         // levels, probe count), then every texel read. A lookup is one long
         // chain of dependent steps (derivatives → λ → level → position →

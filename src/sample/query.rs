@@ -9,7 +9,11 @@
 /// coordinate from one pixel to the next along screen x, `(dudy, dvdy)`
 /// along screen y. Any value may be NaN or infinite; every filter defines
 /// what it does then (see the [`crate::sample`] module docs).
+///
+/// `repr(C)`: six `f32` in field order, so a slice of queries can be read
+/// as a flat array of floats (the SIMD paths load eight queries at once).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[repr(C)]
 pub struct Query {
     /// Horizontal texture coordinate.
     pub u: f32,

@@ -12,11 +12,16 @@
 
 /// Receives every texel a filter reads, in read order.
 pub trait TexelSink {
+    /// False only for a sink that ignores every read ([`NoTrace`]): the
+    /// samplers may then take paths that do not report reads one by one.
+    /// Default: true.
+    const TRACES: bool = true;
     /// Texel `(x, y)` of mip level `level` was read (`x`, `y` in range).
     fn texel(&mut self, level: u32, x: u32, y: u32);
 }
 
 impl<S: TexelSink + ?Sized> TexelSink for &mut S {
+    const TRACES: bool = S::TRACES;
     #[inline(always)]
     fn texel(&mut self, level: u32, x: u32, y: u32) {
         (**self).texel(level, x, y);
@@ -28,6 +33,7 @@ impl<S: TexelSink + ?Sized> TexelSink for &mut S {
 pub struct NoTrace;
 
 impl TexelSink for NoTrace {
+    const TRACES: bool = false;
     #[inline(always)]
     fn texel(&mut self, _level: u32, _x: u32, _y: u32) {}
 }

@@ -1,0 +1,741 @@
+//! AVX-512 lookups for the bilinear and trilinear filters and footprint
+//! assembly (linear magnification and minification filters, mip mode
+//! nearest or linear, no texel tracing), chosen at run time on CPUs with
+//! AVX-512 F, BW, DQ and VL. `PARVO_NO_AVX=1` turns them off.
+//!
+//! # Same answers, bit for bit
+//! These paths perform the portable code's operations on the same values
+//! in the same order — `f64` positions, the exponent-based nearest-mip
+//! rule, the table `log2`, `f32` blends as separate multiplies and adds
+//! (no fused multiply-add) — so they return exactly what the portable
+//! code returns; `tests/sample_simd.rs` compares the two on random and
+//! extreme queries. Only the way the work is spread over registers
+//! differs:
+//!
+//! - **Per block of 8 queries (or 8 probes)**, one lane each: the
+//!   footprint, level choice, blend weight and position of the 2×2 block
+//!   on each level, and whether that block lies inside its level.
+//! - **The texels of those 8 lanes**, one channel of one corner of the
+//!   2×2 block per register: for a packed RGBA8 chain, two 8-texel
+//!   gathers of texel pairs (each row of a block is two adjacent texels)
+//!   and sixteen 8-lane gathers from the chain's decode table; for an
+//!   `f32` chain, sixteen 8-lane gathers of the texel values. The bilinear
+//!   blend then runs on the channels as they are (structure of arrays),
+//!   and a 4 × 8 transpose writes the 8 RGBA results.
+//!
+//! A lane whose block is not inside its level (NaN or huge coordinates,
+//! edge crossings, a λ the table `log2` does not cover) is handed to the
+//! portable code, which handles every case; so are the queries of a
+//! slice's last, partial block.
+
+// Intrinsics: every `unsafe` block below says which features are enabled
+// and why its memory accesses stay in bounds.
+#![allow(unsafe_code)]
+
+use std::arch::x86_64::*;
+use std::sync::OnceLock;
+
+use super::aniso::Setup;
+use super::bilinear::Lin;
+use super::fetch::{Addressing, Chain, Lut8, Pixel};
+use super::footprint::{LOG2_BITS, LOG2_TABLE, Lod, UNBOUNDED_TEXELS};
+use super::trace::NoTrace;
+use super::trilinear::{self, MIP_LINEAR, MIP_NEAREST};
+use super::{Query, SamplerOptions, aniso};
+
+/// True when the CPU has the features these paths need and
+/// `PARVO_NO_AVX` is not set (checked once).
+pub(crate) fn available() -> bool {
+    static OK: OnceLock<bool> = OnceLock::new();
+    *OK.get_or_init(|| {
+        std::env::var_os("PARVO_NO_AVX").is_none()
+            && is_x86_feature_detected!("avx512f")
+            && is_x86_feature_detected!("avx512bw")
+            && is_x86_feature_detected!("avx512dq")
+            && is_x86_feature_detected!("avx512vl")
+            && is_x86_feature_detected!("avx512vbmi")
+    })
+}
+
+/// Most levels the per-lane level tables hold (a 32768-texel side).
+const MAX_LEVELS: usize = 16;
+
+/// True when `c` can take these paths: at most [`MAX_LEVELS`] levels, and
+/// texels that are either packed RGBA8 whose colour channels share a
+/// decode table, or RGBA `f32`.
+pub(crate) fn fits<P: Pixel>(c: &Chain<P>) -> bool {
+    let texels_ok = match P::packed(&c.lut) {
+        Some(l) => std::mem::size_of::<P>() == 4 && l.shared,
+        None => std::mem::size_of::<P>() == 16,
+    };
+    c.levels.len() <= MAX_LEVELS && texels_ok
+}
+
+/// Per-level constants as lane tables (index = level), two registers of
+/// 8 levels each.
+struct Levels {
+    wf: [__m512d; 2],
+    hf: [__m512d; 2],
+    /// `w − 1` and `h − 1`: a block's first index must be below them.
+    wm1: [__m512i; 2],
+    hm1: [__m512i; 2],
+    w: [__m512i; 2],
+    /// Address of the level's first texel (its provenance exposed, see
+    /// [`corners`]).
+    base: [__m512i; 2],
+    /// Bytes per row.
+    row: [__m512i; 2],
+}
+
+impl Levels {
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+    fn new<P: Pixel>(c: &Chain<P>) -> Levels {
+        let (mut wf, mut hf) = ([0f64; 16], [0f64; 16]);
+        let mut int = [[0i64; 16]; 5];
+        let size = std::mem::size_of::<P>() as i64;
+        for (k, l) in c.levels.iter().enumerate().take(MAX_LEVELS) {
+            wf[k] = l.wf;
+            hf[k] = l.hf;
+            int[0][k] = l.w as i64 - 1;
+            int[1][k] = l.h as i64 - 1;
+            int[2][k] = l.w as i64;
+            int[3][k] = l.texels.as_ptr().expose_provenance() as i64;
+            int[4][k] = l.w as i64 * size;
+        }
+        let [wm1, hm1, w, base, row] = int.map(|t| epi64x2(&t));
+        Levels {
+            wf: pd2(&wf),
+            hf: pd2(&hf),
+            wm1,
+            hm1,
+            w,
+            base,
+            row,
+        }
+    }
+}
+
+/// 16 values as two registers.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn pd2(a: &[f64; 16]) -> [__m512d; 2] {
+    // SAFETY: two unaligned 64-byte loads inside the 128-byte array.
+    unsafe {
+        [
+            _mm512_loadu_pd(a.as_ptr()),
+            _mm512_loadu_pd(a.as_ptr().add(8)),
+        ]
+    }
+}
+
+/// 16 values as two registers.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn epi64x2(a: &[i64; 16]) -> [__m512i; 2] {
+    // SAFETY: two unaligned 64-byte loads inside the 128-byte array.
+    unsafe {
+        [
+            _mm512_loadu_epi64(a.as_ptr()),
+            _mm512_loadu_epi64(a.as_ptr().add(8)),
+        ]
+    }
+}
+
+/// The lanes of a register.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn f64s(x: __m512d) -> [f64; 8] {
+    let mut a = [0f64; 8];
+    // SAFETY: one unaligned 64-byte store into the 64-byte array.
+    unsafe { _mm512_storeu_pd(a.as_mut_ptr(), x) };
+    a
+}
+
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn look_pd(t: &[__m512d; 2], idx: __m512i) -> __m512d {
+    _mm512_permutex2var_pd(t[0], idx, t[1])
+}
+
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn look_epi64(t: &[__m512i; 2], idx: __m512i) -> __m512i {
+    _mm512_permutex2var_epi64(t[0], idx, t[1])
+}
+
+/// Where the 2×2 blocks of 8 lanes lie on their levels `lvl`:
+/// `bilinear::bilinear`'s fast path, lane-wise.
+struct Blocks {
+    /// Address of texel (i0, j0) and of (i0, j0 + 1).
+    top: __m512i,
+    bot: __m512i,
+    /// Fractions α and β.
+    al: __m256,
+    be: __m256,
+    /// Lanes whose block lies inside the level.
+    inside: u8,
+}
+
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn blocks<P: Pixel>(ls: &Levels, lvl: __m512i, u: __m512d, v: __m512d) -> Blocks {
+    let half = _mm512_set1_pd(0.5);
+    let x = _mm512_sub_pd(_mm512_mul_pd(u, look_pd(&ls.wf, lvl)), half);
+    let y = _mm512_sub_pd(_mm512_mul_pd(v, look_pd(&ls.hf, lvl)), half);
+    const FLOOR: i32 = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
+    let fx = _mm512_roundscale_pd::<FLOOR>(x);
+    let fy = _mm512_roundscale_pd::<FLOOR>(y);
+    // NaN, ±∞ and values beyond i64 convert to i64::MIN: huge as unsigned,
+    // so outside every level, as `floor_fast` makes them.
+    let i0 = _mm512_cvttpd_epi64(fx);
+    let j0 = _mm512_cvttpd_epi64(fy);
+    let inside = _mm512_cmplt_epu64_mask(i0, look_epi64(&ls.wm1, lvl))
+        & _mm512_cmplt_epu64_mask(j0, look_epi64(&ls.hm1, lvl));
+    let k = _mm512_add_epi64(_mm512_mullo_epi64(j0, look_epi64(&ls.w, lvl)), i0);
+    let size = _mm512_set1_epi64(std::mem::size_of::<P>() as i64);
+    let top = _mm512_add_epi64(look_epi64(&ls.base, lvl), _mm512_mullo_epi64(k, size));
+    Blocks {
+        top,
+        bot: _mm512_add_epi64(top, look_epi64(&ls.row, lvl)),
+        al: _mm512_cvtpd_ps(_mm512_sub_pd(x, fx)),
+        be: _mm512_cvtpd_ps(_mm512_sub_pd(y, fy)),
+        inside,
+    }
+}
+
+/// 64 zero bytes that lanes outside their level read instead of texels
+/// (their results are then replaced by the portable path's).
+static ZEROS: [u64; 8] = [0; 8];
+
+/// The block addresses of 8 lanes, with [`ZEROS`] for the lanes not in
+/// `fast`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn addresses(b: &Blocks, fast: u8) -> ([u64; 8], [u64; 8]) {
+    let zeros = _mm512_set1_epi64(ZEROS.as_ptr().expose_provenance() as i64);
+    let store = |x: __m512i| {
+        let mut a = [0u64; 8];
+        // SAFETY: one unaligned 64-byte store into the 64-byte array.
+        unsafe {
+            _mm512_storeu_epi64(
+                a.as_mut_ptr().cast(),
+                _mm512_mask_blend_epi64(fast, zeros, x),
+            )
+        };
+        a
+    };
+    (store(b.top), store(b.bot))
+}
+
+/// Reads `T` at an address from [`addresses`].
+///
+/// # Safety
+/// The address is a block address of a lane inside its level, or
+/// [`ZEROS`], and `size_of::<T>()` bytes from it stay inside that
+/// allocation (at most 32: two `f32` texels, or [`ZEROS`]).
+#[inline(always)]
+unsafe fn read<T: Copy>(addr: u64) -> T {
+    // SAFETY: the caller's contract; the address came from
+    // `expose_provenance` on an allocation the chain (or the static) keeps
+    // alive.
+    unsafe { std::ptr::with_exposed_provenance::<T>(addr as usize).read_unaligned() }
+}
+
+/// One 256-entry byte table look-up of 64 codes: `vpermi2b` covers 128
+/// entries, the code's top bit (`top`) picks between two.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn look_bytes(codes: __m512i, top: u64, t: &[u8; 256]) -> __m512i {
+    // SAFETY: four 64-byte loads inside the 256-byte table.
+    let q = unsafe { [0, 64, 128, 192].map(|o| _mm512_loadu_epi8(t.as_ptr().add(o).cast())) };
+    let lo = _mm512_permutex2var_epi8(q[0], codes, q[1]);
+    let hi = _mm512_permutex2var_epi8(q[2], codes, q[3]);
+    _mm512_mask_blend_epi8(top, lo, hi)
+}
+
+/// The 2×2 blocks of 4 lanes of a packed RGBA8 chain, decoded: register
+/// `c` holds corner `c` (00, 10, 01, 11) of lane `j` in 128-bit group
+/// `j`, as RGBA `f32`. The 64 codes are looked up in the four byte planes
+/// of the decode table and the planes interleaved back into `f32`s.
+///
+/// # Safety
+/// The addresses satisfy [`read`] for 8 bytes.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
+    // SAFETY: the caller's contract (two adjacent 4-byte texels per row).
+    let x: [__m128i; 4] = std::array::from_fn(|j| unsafe {
+        _mm_set_epi64x(read::<i64>(bot[j]), read::<i64>(top[j]))
+    });
+    let codes = _mm512_inserti64x4::<1>(
+        _mm512_castsi256_si512(_mm256_set_m128i(x[1], x[0])),
+        _mm256_set_m128i(x[3], x[2]),
+    );
+    // Codes of corner k as 32-bit integers, in the layout of the result.
+    let widen = |k: i32, alpha_only: bool| {
+        let z = -128i8 as i32 & 0xFF;
+        let byte = |b: i32| if alpha_only && b != 3 { z } else { 4 * k + b };
+        let dw = |b: i32| byte(b) | z << 8 | z << 16 | z << 24;
+        let pattern = _mm512_set4_epi32(dw(3), dw(2), dw(1), dw(0));
+        let v = _mm512_shuffle_epi8(codes, pattern);
+        _mm512_mul_ps(_mm512_cvtepi32_ps(v), _mm512_set1_ps(1.0 / 255.0))
+    };
+    // Alpha floats: 3, 7, 11, 15.
+    const ALPHA16: u16 = 0x8888;
+    if lut.colour_linear && (lut.alpha_same || lut.alpha_linear) {
+        return [0, 1, 2, 3].map(|k| widen(k, false));
+    }
+    let top7 = _mm512_movepi8_mask(codes);
+    // Bytes 3, 7, 11, … are alpha codes.
+    const ALPHA: u64 = 0x8888_8888_8888_8888;
+    let planes_alpha = !lut.alpha_same && !lut.alpha_linear;
+    let p: [__m512i; 4] = std::array::from_fn(|k| {
+        let c = look_bytes(codes, top7, &lut.planes[0][k]);
+        if planes_alpha {
+            _mm512_mask_blend_epi8(ALPHA, c, look_bytes(codes, top7, &lut.planes[1][k]))
+        } else {
+            c
+        }
+    });
+    // Within each 128-bit group (one lane's 16 codes): bytes 0-1 and 2-3
+    // of each f32, then the f32s of codes 0-3, 4-7, 8-11 and 12-15.
+    let a = _mm512_unpacklo_epi8(p[0], p[1]);
+    let b = _mm512_unpackhi_epi8(p[0], p[1]);
+    let c = _mm512_unpacklo_epi8(p[2], p[3]);
+    let d = _mm512_unpackhi_epi8(p[2], p[3]);
+    let d = [
+        _mm512_castsi512_ps(_mm512_unpacklo_epi16(a, c)),
+        _mm512_castsi512_ps(_mm512_unpackhi_epi16(a, c)),
+        _mm512_castsi512_ps(_mm512_unpacklo_epi16(b, d)),
+        _mm512_castsi512_ps(_mm512_unpackhi_epi16(b, d)),
+    ];
+    if lut.alpha_linear && !lut.alpha_same {
+        std::array::from_fn(|k| _mm512_mask_blend_ps(ALPHA16, d[k], widen(k as i32, true)))
+    } else {
+        d
+    }
+}
+
+/// [`group_rgba8`] for an RGBA `f32` chain: two 32-byte loads per lane.
+///
+/// # Safety
+/// The addresses satisfy [`read`] for 32 bytes.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+unsafe fn group_f32(top: &[u64], bot: &[u64]) -> [__m512; 4] {
+    // Two lanes' rows [t0 t1 | t0' t1'] per register.
+    let pair = |r: &[u64], j: usize| {
+        // SAFETY: the caller's contract.
+        let (x, y) = unsafe { (read::<__m256>(r[j]), read::<__m256>(r[j + 1])) };
+        _mm512_insertf32x8::<1>(_mm512_castps256_ps512(x), y)
+    };
+    let (t01, t23) = (pair(top, 0), pair(top, 2));
+    let (b01, b23) = (pair(bot, 0), pair(bot, 2));
+    [
+        _mm512_shuffle_f32x4::<0b10_00_10_00>(t01, t23),
+        _mm512_shuffle_f32x4::<0b11_01_11_01>(t01, t23),
+        _mm512_shuffle_f32x4::<0b10_00_10_00>(b01, b23),
+        _mm512_shuffle_f32x4::<0b11_01_11_01>(b01, b23),
+    ]
+}
+
+/// The decoded blocks of lanes `4h … 4h + 3`.
+///
+/// # Safety
+/// As [`group_rgba8`] or [`group_f32`].
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+unsafe fn group<P: Pixel>(lut: &P::Lut, top: &[u64; 8], bot: &[u64; 8], h: usize) -> [__m512; 4] {
+    let (t, b) = (&top[4 * h..4 * h + 4], &bot[4 * h..4 * h + 4]);
+    match P::packed(lut) {
+        // SAFETY: the caller's contract.
+        Some(l) => unsafe { group_rgba8(l, t, b) },
+        // SAFETY: the caller's contract.
+        None => unsafe { group_f32(t, b) },
+    }
+}
+
+/// Lane `4h + j` of an 8-lane vector in every float of 128-bit group `j`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn spread(x: __m256, h: usize) -> __m512 {
+    let b = 4 * h as i32;
+    let idx = _mm512_set_epi32(
+        b + 3,
+        b + 3,
+        b + 3,
+        b + 3,
+        b + 2,
+        b + 2,
+        b + 2,
+        b + 2,
+        b + 1,
+        b + 1,
+        b + 1,
+        b + 1,
+        b,
+        b,
+        b,
+        b,
+    );
+    _mm512_permutexvar_ps(idx, _mm512_castps256_ps512(x))
+}
+
+/// `x·(1 − t) + y·t` with `omt` = 1 − t, as `fetch::lerp`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn lerp16(x: __m512, y: __m512, omt: __m512, t: __m512) -> __m512 {
+    _mm512_add_ps(_mm512_mul_ps(x, omt), _mm512_mul_ps(y, t))
+}
+
+/// The bilinear blend of the decoded blocks of lanes `4h … 4h + 3`:
+/// `lerp(lerp(t00, t10, α), lerp(t01, t11, α), β)`, as `Pixel::bilerp`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn bilerp(d: [__m512; 4], b: &Blocks, h: usize) -> __m512 {
+    let one = _mm256_set1_ps(1.0);
+    let (al, be) = (spread(b.al, h), spread(b.be, h));
+    let (oma, omb) = (
+        spread(_mm256_sub_ps(one, b.al), h),
+        spread(_mm256_sub_ps(one, b.be), h),
+    );
+    lerp16(
+        lerp16(d[0], d[1], oma, al),
+        lerp16(d[2], d[3], oma, al),
+        omb,
+        be,
+    )
+}
+
+/// The 4 bits of `m` for lanes `4h … 4h + 3`, each repeated over the 4
+/// floats of its group.
+#[inline(always)]
+fn group_mask(m: u8, h: usize) -> u16 {
+    let m = (m >> (4 * h)) as u16;
+    (0..4).fold(0, |acc, j| acc | ((m >> j & 1) * 0xF) << (4 * j))
+}
+
+/// Eight queries' fields as `f64` lanes: u, v, ∂u/∂x, ∂v/∂x, ∂u/∂y,
+/// ∂v/∂y.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn fields(qs: &[Query; 8]) -> [__m512d; 6] {
+    let p = qs.as_ptr().cast::<f32>();
+    // SAFETY: `Query` is `repr(C)` with six `f32` fields, so 8 queries are
+    // 48 floats: three 64-byte loads.
+    let z = unsafe {
+        [
+            _mm512_loadu_ps(p),
+            _mm512_loadu_ps(p.add(16)),
+            _mm512_loadu_ps(p.add(32)),
+        ]
+    };
+    std::array::from_fn(|f| {
+        // Lane i of field f is float 6i + f: from z[0..2] for 6i + f < 32,
+        // from z[2] above.
+        let idx: [i32; 16] = std::array::from_fn(|i| ((6 * i.min(7) + f) % 32) as i32);
+        let hi = (0..8).fold(0u16, |m, i| m | (u16::from(6 * i + f >= 32) << i));
+        // SAFETY: loads of two local arrays of 16 lanes.
+        let idx = unsafe { _mm512_loadu_epi32(idx.as_ptr()) };
+        let lo_part = _mm512_permutex2var_ps(z[0], idx, z[1]);
+        let hi_part = _mm512_permutexvar_ps(idx, z[2]);
+        let lanes = _mm512_mask_blend_ps(hi, lo_part, hi_part);
+        _mm512_cvtps_pd(_mm512_castps512_ps256(lanes))
+    })
+}
+
+/// ρmax² per lane, as `Lod::rho2`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn rho2(lod: &Lod, f: &[__m512d; 6]) -> __m512d {
+    let (wf, hf) = (_mm512_set1_pd(lod.wf), _mm512_set1_pd(lod.hf));
+    let (ax, ay) = (_mm512_mul_pd(f[2], wf), _mm512_mul_pd(f[3], hf));
+    let (bx, by) = (_mm512_mul_pd(f[4], wf), _mm512_mul_pd(f[5], hf));
+    let rx2 = _mm512_add_pd(_mm512_mul_pd(ax, ax), _mm512_mul_pd(ay, ay));
+    let ry2 = _mm512_add_pd(_mm512_mul_pd(bx, bx), _mm512_mul_pd(by, by));
+    let s = _mm512_add_pd(rx2, ry2);
+    let bad = _mm512_cmp_pd_mask::<_CMP_UNORD_Q>(s, s)
+        | _mm512_cmp_pd_mask::<_CMP_GT_OQ>(s, _mm512_set1_pd(f64::MAX));
+    let ge = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(rx2, ry2);
+    let m = _mm512_mask_blend_pd(ge, ry2, rx2);
+    _mm512_mask_blend_pd(bad, m, _mm512_set1_pd(UNBOUNDED_TEXELS * UNBOUNDED_TEXELS))
+}
+
+/// `x < lo ? lo : x` then `x > hi ? hi : x` (`f64::clamp` for non-NaN
+/// bounds; NaN passes through).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn clamp_pd(x: __m512d, lo: f64, hi: f64) -> __m512d {
+    let (lo, hi) = (_mm512_set1_pd(lo), _mm512_set1_pd(hi));
+    let x = _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_LT_OQ>(x, lo), x, lo);
+    _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_GT_OQ>(x, hi), x, hi)
+}
+
+/// The table `log2` of `footprint::log2` per lane, and the lanes it
+/// covers (normal, finite x); the others need the library `log2`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn log2(x: __m512d) -> (__m512d, u8) {
+    let ok = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(x, _mm512_set1_pd(f64::MIN_POSITIVE))
+        & _mm512_cmp_pd_mask::<_CMP_LE_OQ>(x, _mm512_set1_pd(f64::MAX));
+    let bits = _mm512_castpd_si512(x);
+    let e = _mm512_cvtepi64_pd(_mm512_sub_epi64(
+        _mm512_srli_epi64::<52>(bits),
+        _mm512_set1_epi64(1023),
+    ));
+    let mant = _mm512_and_si512(bits, _mm512_set1_epi64((1 << 52) - 1));
+    let i = _mm512_srli_epi64::<{ 52 - LOG2_BITS }>(mant);
+    let f = _mm512_mul_pd(
+        _mm512_cvtepi64_pd(_mm512_and_si512(
+            mant,
+            _mm512_set1_epi64((1 << (52 - LOG2_BITS)) - 1),
+        )),
+        _mm512_set1_pd(1.0 / (1u64 << (52 - LOG2_BITS)) as f64),
+    );
+    let t = LOG2_TABLE.as_ptr();
+    // SAFETY: i = mant >> 42 ≤ 1023 for every lane (mant < 2^52) and the
+    // table has 1025 entries, so i and i + 1 are in bounds.
+    let (a, b) = unsafe {
+        (
+            _mm512_cvtps_pd(_mm512_i64gather_ps::<4>(i, t)),
+            _mm512_cvtps_pd(_mm512_i64gather_ps::<4>(i, t.add(1))),
+        )
+    };
+    let r = _mm512_add_pd(e, _mm512_add_pd(a, _mm512_mul_pd(f, _mm512_sub_pd(b, a))));
+    (r, ok)
+}
+
+/// The plan of 8 isotropic lookups, as `trilinear::plan::<Lin, MIP>`:
+/// levels `hi` and `lo` and the blend δ per lane, and the lanes whose
+/// plan this computes exactly (the others take the portable path).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn plans<const MIP: u8>(
+    lod: &Lod,
+    o: &SamplerOptions,
+    f: &[__m512d; 6],
+) -> (__m512i, __m512i, __m256, u8) {
+    let r2 = rho2(lod, f);
+    if MIP == MIP_NEAREST {
+        // `Lod::plan_nearest`: the level from the exponent of y.
+        let y = clamp_pd(
+            _mm512_mul_pd(r2, _mm512_set1_pd(lod.scale)),
+            lod.y_min,
+            lod.y_max,
+        );
+        let e = _mm512_srli_epi64::<52>(_mm512_add_epi64(
+            _mm512_castpd_si512(y),
+            _mm512_set1_epi64((1 << 52) - 1),
+        ));
+        let c = _mm512_sub_epi64(e, _mm512_set1_epi64(1023));
+        let d = _mm512_min_epi64(
+            _mm512_max_epi64(_mm512_srai_epi64::<1>(c), _mm512_setzero_si512()),
+            _mm512_set1_epi64(lod.q as i64),
+        );
+        (d, d, _mm256_setzero_ps(), 0xFF)
+    } else {
+        // `Lod::lambda`, then `Plan::at(λ, q, Linear)`.
+        let (l2, ok) = log2(r2);
+        let base = _mm512_add_pd(
+            _mm512_mul_pd(_mm512_set1_pd(0.5), l2),
+            _mm512_set1_pd(o.lod_bias as f64),
+        );
+        let lambda = _mm512_cvtpd_ps(clamp_pd(base, o.lod_min as f64, o.lod_max as f64));
+        let zero = _mm256_setzero_ps();
+        // λ ≤ 0 (or NaN): magnification, level 0 alone.
+        let minify = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(lambda, zero);
+        let q = _mm256_set1_epi32(lod.q as i32);
+        let d = _mm256_min_ps(_mm256_max_ps(lambda, zero), _mm256_set1_ps(lod.q as f32));
+        let h = _mm256_min_epi32(_mm256_cvttps_epi32(d), q);
+        let lo = _mm256_min_epi32(_mm256_add_epi32(h, _mm256_set1_epi32(1)), q);
+        let delta = _mm256_maskz_mov_ps(minify, _mm256_sub_ps(d, _mm256_cvtepi32_ps(h)));
+        let h = _mm256_maskz_mov_epi32(minify, h);
+        let lo = _mm256_maskz_mov_epi32(minify, lo);
+        (
+            _mm512_cvtepi32_epi64(h),
+            _mm512_cvtepi32_epi64(lo),
+            delta,
+            ok,
+        )
+    }
+}
+
+/// Isotropic bilinear or trilinear lookups (`Lin` filters, mip mode
+/// `MIP` nearest or linear) of `queries` into `out`: what
+/// `trilinear::plan` and `trilinear::probe` compute, 8 queries at a time.
+///
+/// # Safety
+/// [`available`] is true and [`fits`]`(c)`.
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    opts: &SamplerOptions,
+    queries: &[Query],
+    out: &mut [[f32; 4]],
+) {
+    let ls = Levels::new(c);
+    let mut qs = queries.chunks_exact(8);
+    let mut os = out.chunks_exact_mut(8);
+    for (q8, o8) in (&mut qs).zip(&mut os) {
+        let q8: &[Query; 8] = q8.try_into().expect("8 queries");
+        let f = fields(q8);
+        let (hi, lo, delta, ok) = plans::<MIP>(lod, opts, &f);
+        let bh = blocks::<P>(&ls, hi, f[0], f[1]);
+        let mut fast = ok & bh.inside;
+        // Lanes that blend a second level (δ > 0 and a different level).
+        let (two, bl) = if MIP == MIP_LINEAR {
+            let two = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(delta, _mm256_setzero_ps())
+                & _mm512_cmpneq_epi64_mask(lo, hi);
+            let bl = blocks::<P>(&ls, lo, f[0], f[1]);
+            fast &= !two | bl.inside;
+            (two & fast, Some(bl))
+        } else {
+            (0, None)
+        };
+        let (top, bot) = addresses(&bh, fast);
+        let second = bl.as_ref().map(|b| addresses(b, two));
+        let omd = _mm256_sub_ps(_mm256_set1_ps(1.0), delta);
+        for h in 0..2 {
+            // SAFETY: lanes in `fast` are inside their level, the others
+            // read `ZEROS` (`addresses`).
+            let mut r = bilerp(unsafe { group::<P>(&c.lut, &top, &bot, h) }, &bh, h);
+            let m = group_mask(two, h);
+            if let (Some(b), Some((t2, b2))) = (&bl, &second)
+                && m != 0
+            {
+                // SAFETY: as above, with the lanes in `two`.
+                let r2 = bilerp(unsafe { group::<P>(&c.lut, t2, b2, h) }, b, h);
+                let mixed = lerp16(r, r2, spread(omd, h), spread(delta, h));
+                r = _mm512_mask_blend_ps(m, r, mixed);
+            }
+            // SAFETY: one unaligned 64-byte store into 4 RGBA values.
+            unsafe { _mm512_storeu_ps(o8[4 * h..].as_mut_ptr().cast(), r) };
+        }
+        if fast != 0xFF {
+            for (i, (q, o)) in q8.iter().zip(o8.iter_mut()).enumerate() {
+                if fast >> i & 1 == 0 {
+                    *o = portable::<P, MIP>(c, a, lod, opts, q);
+                }
+            }
+        }
+    }
+    for (q, o) in qs.remainder().iter().zip(os.into_remainder()) {
+        *o = portable::<P, MIP>(c, a, lod, opts, q);
+    }
+}
+
+/// One isotropic lookup the portable way.
+#[inline(never)]
+fn portable<P: Pixel, const MIP: u8>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    o: &SamplerOptions,
+    q: &Query,
+) -> [f32; 4] {
+    let p = trilinear::plan::<Lin, MIP>(lod, o, q);
+    trilinear::probe(c, Lin, &p, q.u as f64, q.v as f64, a, &mut NoTrace)
+}
+
+/// Footprint-assembly lookups (`Lin` filters, mip mode `MIP`) of
+/// `queries` into `out`: `aniso::setup` per query as the portable code
+/// does it, then the probes 8 at a time.
+///
+/// # Safety
+/// [`available`] is true and [`fits`]`(c)`.
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    opts: &SamplerOptions,
+    queries: &[Query],
+    out: &mut [[f32; 4]],
+) {
+    let ls = Levels::new(c);
+    for (qs, os) in queries
+        .chunks(super::BLOCK)
+        .zip(out.chunks_mut(super::BLOCK))
+    {
+        let mut st = [Setup::EMPTY; super::BLOCK];
+        for (s, q) in st.iter_mut().zip(qs) {
+            *s = aniso::setup::<Lin, MIP>(lod, opts, q);
+        }
+        for (s, o) in st.iter().zip(os.iter_mut()) {
+            *o = probes(c, &ls, a, s);
+        }
+    }
+}
+
+/// The probes of one footprint-assembly lookup, as `aniso::anisotropic`:
+/// 8 probe positions per step, summed in probe order.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn probes<P: Pixel>(c: &Chain<P>, ls: &Levels, a: &Addressing, st: &Setup) -> [f32; 4] {
+    let (n, plan) = (st.probes.max(1), &st.plan);
+    let (hi, lo) = (
+        _mm512_set1_epi64(plan.hi as i64),
+        _mm512_set1_epi64(plan.lo as i64),
+    );
+    let two = plan.delta > 0.0 && plan.lo != plan.hi;
+    let (delta, omd) = (_mm512_set1_ps(plan.delta), _mm512_set1_ps(1.0 - plan.delta));
+    let step = _mm512_set1_pd(1.0 / (n as f64 + 1.0));
+    let inv = 1.0 / n as f32;
+    let mut acc = [0f32; 4];
+    let mut first = 1;
+    while first <= n {
+        let lanes = (n + 1 - first).min(8);
+        let (pu, pv) = if n == 1 {
+            // One probe, at the centre itself.
+            (_mm512_set1_pd(st.u), _mm512_set1_pd(st.v))
+        } else {
+            let i = _mm512_add_pd(
+                _mm512_set_pd(7.0, 6.0, 5.0, 4.0, 3.0, 2.0, 1.0, 0.0),
+                _mm512_set1_pd(first as f64),
+            );
+            let t = _mm512_sub_pd(_mm512_mul_pd(i, step), _mm512_set1_pd(0.5));
+            let along = |c: f64, d: f64| {
+                _mm512_add_pd(_mm512_set1_pd(c), _mm512_mul_pd(t, _mm512_set1_pd(d)))
+            };
+            (along(st.u, st.major[0]), along(st.v, st.major[1]))
+        };
+        let live = ((1u16 << lanes) - 1) as u8;
+        let bh = blocks::<P>(ls, hi, pu, pv);
+        let bl = two.then(|| blocks::<P>(ls, lo, pu, pv));
+        let fast = live & bh.inside & bl.as_ref().map_or(0xFF, |b| b.inside);
+        let (top, bot) = addresses(&bh, fast);
+        let second = bl.as_ref().map(|b| addresses(b, fast));
+        let mut p = [[0f32; 4]; 8];
+        for h in 0..lanes.div_ceil(4) as usize {
+            // SAFETY: lanes in `fast` are inside their level, the others
+            // read `ZEROS` (`addresses`).
+            let mut r = bilerp(unsafe { group::<P>(&c.lut, &top, &bot, h) }, &bh, h);
+            if let (Some(b), Some((t2, b2))) = (&bl, &second) {
+                // SAFETY: as above.
+                let r2 = bilerp(unsafe { group::<P>(&c.lut, t2, b2, h) }, b, h);
+                r = lerp16(r, r2, omd, delta);
+            }
+            // SAFETY: one unaligned 64-byte store into 4 RGBA values.
+            unsafe { _mm512_storeu_ps(p[4 * h..].as_mut_ptr().cast(), r) };
+        }
+        if fast != live {
+            let (pus, pvs) = (f64s(pu), f64s(pv));
+            for i in (0..lanes as usize).filter(|&i| fast >> i & 1 == 0) {
+                p[i] = trilinear::probe(c, Lin, plan, pus[i], pvs[i], a, &mut NoTrace);
+            }
+        }
+        if n == 1 {
+            return p[0];
+        }
+        for p in &p[..lanes as usize] {
+            for k in 0..4 {
+                acc[k] += p[k] * inv;
+            }
+        }
+        first += 8;
+    }
+    acc
+}

@@ -1,0 +1,147 @@
+//! The SIMD lookups (AVX-512, taken by untraced bilinear, trilinear and
+//! footprint-assembly lookups on CPUs that have it) against the portable
+//! code, bit for bit.
+//!
+//! A lookup with a tracing sink always runs the portable code (it reports
+//! texels one by one), so `sample_slice` and `sample_slice_traced` on the
+//! same queries compare the two paths. On a CPU without AVX-512 both run
+//! the portable code and the comparison holds trivially; the test says
+//! which it ran (`Sampler::uses_simd`).
+
+use parvo::sample::{Query, Sampler, SamplerOptions, TexelCounter};
+use parvo::texel::{ChannelType, ColorSpace, Format};
+use parvo::{MipOptions, Wrap, WrapMode, mip};
+
+mod common;
+use common::Rng;
+
+/// Random queries over a few periods, with edge, NaN, infinite, huge and
+/// zero values mixed in.
+fn queries(r: &mut Rng, n: usize) -> Vec<Query> {
+    let odd = [
+        0.0,
+        -0.0,
+        1.0,
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        1e30,
+        -1e30,
+        1e-30,
+        1e6,
+    ];
+    (0..n)
+        .map(|_| {
+            let mut v = [
+                r.f() * 3.0 - 1.0,
+                r.f() * 3.0 - 1.0,
+                (r.f() - 0.5) * 0.3,
+                (r.f() - 0.5) * 0.05,
+                (r.f() - 0.5) * 0.05,
+                (r.f() - 0.5) * 0.2,
+            ];
+            // Grazing: one derivative vector much longer than the other.
+            if r.next_u64().is_multiple_of(4) {
+                v[2] *= 0.01;
+                v[3] *= 0.01;
+            }
+            if r.next_u64().is_multiple_of(8) {
+                let k = (r.next_u64() % 6) as usize;
+                v[k] = odd[(r.next_u64() % odd.len() as u64) as usize];
+            }
+            Query::new(v[0], v[1], v[2], v[3], v[4], v[5])
+        })
+        .collect()
+}
+
+fn options() -> Vec<SamplerOptions> {
+    let mut v = Vec::new();
+    for base in [
+        SamplerOptions::bilinear(),
+        SamplerOptions::trilinear(),
+        SamplerOptions::aniso(4),
+        SamplerOptions::aniso(16),
+        SamplerOptions {
+            mip: parvo::sample::MipMode::Nearest,
+            ..SamplerOptions::aniso(8)
+        },
+    ] {
+        v.push(base);
+        v.push(SamplerOptions {
+            lod_bias: 0.75,
+            lod_min: 0.5,
+            lod_max: 3.0,
+            wrap: Wrap {
+                u: WrapMode::MirroredRepeat,
+                v: WrapMode::ClampToBorder,
+            },
+            border: [0.25, 0.5, 0.75, 1.0],
+            ..base
+        });
+        v.push(SamplerOptions {
+            lod_bias: -1.5,
+            wrap: Wrap {
+                u: WrapMode::ClampToEdge,
+                v: WrapMode::MirrorClampToEdge,
+            },
+            ..base
+        });
+    }
+    v
+}
+
+#[test]
+fn simd_lookups_equal_the_portable_lookups_bit_for_bit() {
+    let formats = [
+        Format::new(4, ChannelType::U8, ColorSpace::Srgb),
+        Format::new(4, ChannelType::U8, ColorSpace::Linear),
+        Format::new(3, ChannelType::U8, ColorSpace::Srgb),
+        Format::new(2, ChannelType::U8, ColorSpace::Srgb),
+        Format::new(1, ChannelType::U8, ColorSpace::Linear),
+        Format::new(4, ChannelType::F16, ColorSpace::Linear),
+        Format::new(4, ChannelType::F32, ColorSpace::Linear),
+    ];
+    let mut r = Rng(0x51_3d);
+    let mut simd_seen = false;
+    for format in formats {
+        for (w, h) in common::AWKWARD {
+            let tex = common::random_texture(&mut r, w, h, format);
+            let chain = mip::build(tex, &MipOptions::default()).unwrap();
+            // 333 queries: not a multiple of the 8-query blocks.
+            let qs = queries(&mut r, 333);
+            for o in options() {
+                let s = Sampler::new(&chain, o).unwrap();
+                simd_seen |= s.uses_simd();
+                let mut fast = vec![[0f32; 4]; qs.len()];
+                let mut plain = vec![[0f32; 4]; qs.len()];
+                s.sample_slice(&qs, &mut fast).unwrap();
+                let mut sink = TexelCounter::default();
+                s.sample_slice_traced(&qs, &mut plain, &mut sink).unwrap();
+                for (i, (a, b)) in fast.iter().zip(&plain).enumerate() {
+                    assert_eq!(
+                        a.map(f32::to_bits),
+                        b.map(f32::to_bits),
+                        "{format:?} {w}x{h} {} query {:?}: {a:?} vs {b:?}",
+                        o.name(),
+                        qs[i]
+                    );
+                }
+                // One query at a time takes the same path as a slice.
+                for (q, want) in qs.iter().zip(&plain).step_by(37) {
+                    assert_eq!(s.sample(q).map(f32::to_bits), want.map(f32::to_bits));
+                }
+            }
+        }
+    }
+    eprintln!("SIMD path taken: {simd_seen}");
+    #[cfg(target_arch = "x86_64")]
+    if std::env::var_os("PARVO_NO_AVX").is_none()
+        && std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512bw")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("avx512vbmi")
+    {
+        assert!(simd_seen, "the CPU has AVX-512 but no sampler used it");
+    }
+}
