@@ -272,19 +272,20 @@ unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
         _mm512_castsi256_si512(_mm256_set_m128i(x[1], x[0])),
         _mm256_set_m128i(x[3], x[2]),
     );
-    // Codes of corner k as 32-bit integers, in the layout of the result.
-    let widen = |k: i32, alpha_only: bool| {
-        let z = -128i8 as i32 & 0xFF;
-        let byte = |b: i32| if alpha_only && b != 3 { z } else { 4 * k + b };
-        let dw = |b: i32| byte(b) | z << 8 | z << 16 | z << 24;
-        let pattern = _mm512_set4_epi32(dw(3), dw(2), dw(1), dw(0));
+    // Codes as 32-bit integers times 1/255, in each 128-bit group:
+    // corner k (all four channels), or the alpha codes of the four corners.
+    let widen = |pattern: [i32; 4]| {
+        let pattern = _mm512_set4_epi32(pattern[3], pattern[2], pattern[1], pattern[0]);
         let v = _mm512_shuffle_epi8(codes, pattern);
         _mm512_mul_ps(_mm512_cvtepi32_ps(v), _mm512_set1_ps(1.0 / 255.0))
     };
-    // Alpha floats: 3, 7, 11, 15.
-    const ALPHA16: u16 = 0x8888;
+    // Byte b alone in a 32-bit lane (0x80 bytes read as 0).
+    const fn dw(b: i32) -> i32 {
+        b | (0x80 << 8) | (0x80 << 16) | (0x80 << 24)
+    }
     if lut.colour_linear && (lut.alpha_same || lut.alpha_linear) {
-        return [0, 1, 2, 3].map(|k| widen(k, false));
+        return [0, 1, 2, 3]
+            .map(|k| widen([dw(4 * k), dw(4 * k + 1), dw(4 * k + 2), dw(4 * k + 3)]));
     }
     let top7 = _mm512_movepi8_mask(codes);
     // Bytes 3, 7, 11, … are alpha codes.
@@ -311,7 +312,16 @@ unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
         _mm512_castsi512_ps(_mm512_unpackhi_epi16(b, d)),
     ];
     if lut.alpha_linear && !lut.alpha_same {
-        std::array::from_fn(|k| _mm512_mask_blend_ps(ALPHA16, d[k], widen(k as i32, true)))
+        // Alphas of corners 00, 10, 01, 11; float 3 of each group of
+        // corner k takes alpha k.
+        const ALPHA16: u16 = 0x8888;
+        let al = widen([dw(3), dw(7), dw(11), dw(15)]);
+        [
+            _mm512_mask_shuffle_ps::<0b00_00_00_00>(d[0], ALPHA16, al, al),
+            _mm512_mask_shuffle_ps::<0b01_01_01_01>(d[1], ALPHA16, al, al),
+            _mm512_mask_shuffle_ps::<0b10_10_10_10>(d[2], ALPHA16, al, al),
+            _mm512_mask_shuffle_ps::<0b11_11_11_11>(d[3], ALPHA16, al, al),
+        ]
     } else {
         d
     }
@@ -432,18 +442,48 @@ fn fields(qs: &[Query; 8]) -> [__m512d; 6] {
         ]
     };
     std::array::from_fn(|f| {
-        // Lane i of field f is float 6i + f: from z[0..2] for 6i + f < 32,
-        // from z[2] above.
-        let idx: [i32; 16] = std::array::from_fn(|i| ((6 * i.min(7) + f) % 32) as i32);
-        let hi = (0..8).fold(0u16, |m, i| m | (u16::from(6 * i + f >= 32) << i));
-        // SAFETY: loads of two local arrays of 16 lanes.
-        let idx = unsafe { _mm512_loadu_epi32(idx.as_ptr()) };
+        // SAFETY: a load of a 16-lane constant.
+        let idx = unsafe { _mm512_loadu_epi32(FIELD_INDEX[f].as_ptr()) };
         let lo_part = _mm512_permutex2var_ps(z[0], idx, z[1]);
         let hi_part = _mm512_permutexvar_ps(idx, z[2]);
-        let lanes = _mm512_mask_blend_ps(hi, lo_part, hi_part);
+        let lanes = _mm512_mask_blend_ps(FIELD_HIGH[f], lo_part, hi_part);
         _mm512_cvtps_pd(_mm512_castps512_ps256(lanes))
     })
 }
+
+/// Lane i of field f is float 6i + f of eight queries: taken from the
+/// first two registers (index mod 32) below 32, from the third above
+/// ([`FIELD_HIGH`]).
+const FIELD_INDEX: [[i32; 16]; 6] = {
+    let mut t = [[0i32; 16]; 6];
+    let mut f = 0;
+    while f < 6 {
+        let mut i = 0;
+        while i < 8 {
+            t[f][i] = ((6 * i + f) % 32) as i32;
+            i += 1;
+        }
+        f += 1;
+    }
+    t
+};
+
+/// The lanes of each field taken from the third register.
+const FIELD_HIGH: [u16; 6] = {
+    let mut t = [0u16; 6];
+    let mut f = 0;
+    while f < 6 {
+        let mut i = 0;
+        while i < 8 {
+            if 6 * i + f >= 32 {
+                t[f] |= 1 << i;
+            }
+            i += 1;
+        }
+        f += 1;
+    }
+    t
+};
 
 /// ρmax² per lane, as `Lod::rho2`.
 #[inline]
