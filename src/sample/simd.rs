@@ -103,7 +103,13 @@ impl Levels {
             int[3][k] = l.texels.as_ptr().expose_provenance() as i64;
             int[4][k] = l.w as i64 * size;
         }
-        let [wm1, hm1, w, base, row] = int.map(|t| epi64x2(&t));
+        let [wm1, hm1, w, base, row] = [
+            epi64x2(&int[0]),
+            epi64x2(&int[1]),
+            epi64x2(&int[2]),
+            epi64x2(&int[3]),
+            epi64x2(&int[4]),
+        ];
         Levels {
             wf: pd2(&wf),
             hf: pd2(&hf),
@@ -214,18 +220,19 @@ static ZEROS: [u64; 8] = [0; 8];
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn addresses(b: &Blocks, fast: u8) -> ([u64; 8], [u64; 8]) {
     let zeros = _mm512_set1_epi64(ZEROS.as_ptr().expose_provenance() as i64);
-    let store = |x: __m512i| {
-        let mut a = [0u64; 8];
-        // SAFETY: one unaligned 64-byte store into the 64-byte array.
-        unsafe {
-            _mm512_storeu_epi64(
-                a.as_mut_ptr().cast(),
-                _mm512_mask_blend_epi64(fast, zeros, x),
-            )
-        };
-        a
-    };
-    (store(b.top), store(b.bot))
+    let (mut top, mut bot) = ([0u64; 8], [0u64; 8]);
+    // SAFETY: unaligned 64-byte stores into the 64-byte arrays.
+    unsafe {
+        _mm512_storeu_epi64(
+            top.as_mut_ptr().cast(),
+            _mm512_mask_blend_epi64(fast, zeros, b.top),
+        );
+        _mm512_storeu_epi64(
+            bot.as_mut_ptr().cast(),
+            _mm512_mask_blend_epi64(fast, zeros, b.bot),
+        );
+    }
+    (top, bot)
 }
 
 /// Reads `T` at an address from [`addresses`].
@@ -248,10 +255,34 @@ unsafe fn read<T: Copy>(addr: u64) -> T {
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn look_bytes(codes: __m512i, top: u64, t: &[u8; 256]) -> __m512i {
     // SAFETY: four 64-byte loads inside the 256-byte table.
-    let q = unsafe { [0, 64, 128, 192].map(|o| _mm512_loadu_epi8(t.as_ptr().add(o).cast())) };
+    let q = unsafe {
+        let p = t.as_ptr().cast::<i8>();
+        [
+            _mm512_loadu_epi8(p),
+            _mm512_loadu_epi8(p.add(64)),
+            _mm512_loadu_epi8(p.add(128)),
+            _mm512_loadu_epi8(p.add(192)),
+        ]
+    };
     let lo = _mm512_permutex2var_epi8(q[0], codes, q[1]);
     let hi = _mm512_permutex2var_epi8(q[2], codes, q[3]);
     _mm512_mask_blend_epi8(top, lo, hi)
+}
+
+/// Byte `b` of a 128-bit group alone in a 32-bit lane (`vpshufb` reads a
+/// 0x80 byte as 0).
+const fn dw(b: i32) -> i32 {
+    b | (0x80 << 8) | (0x80 << 16) | (0x80 << 24)
+}
+
+/// The bytes `pattern` selects from each 128-bit group of `codes`, as
+/// `f32` times 1/255 (`texel::decode_u8` for linear channels).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn widen(codes: __m512i, pattern: [i32; 4]) -> __m512 {
+    let pattern = _mm512_set4_epi32(pattern[3], pattern[2], pattern[1], pattern[0]);
+    let v = _mm512_shuffle_epi8(codes, pattern);
+    _mm512_mul_ps(_mm512_cvtepi32_ps(v), _mm512_set1_ps(1.0 / 255.0))
 }
 
 /// The 2×2 blocks of 4 lanes of a packed RGBA8 chain, decoded: register
@@ -265,40 +296,36 @@ fn look_bytes(codes: __m512i, top: u64, t: &[u8; 256]) -> __m512i {
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
     // SAFETY: the caller's contract (two adjacent 4-byte texels per row).
-    let x: [__m128i; 4] = std::array::from_fn(|j| unsafe {
-        _mm_set_epi64x(read::<i64>(bot[j]), read::<i64>(top[j]))
-    });
+    let mut x = [_mm_setzero_si128(); 4];
+    for (j, x) in x.iter_mut().enumerate() {
+        // SAFETY: the caller's contract (two adjacent 4-byte texels per
+        // row).
+        *x = unsafe { _mm_set_epi64x(read::<i64>(bot[j]), read::<i64>(top[j])) };
+    }
     let codes = _mm512_inserti64x4::<1>(
         _mm512_castsi256_si512(_mm256_set_m128i(x[1], x[0])),
         _mm256_set_m128i(x[3], x[2]),
     );
-    // Codes as 32-bit integers times 1/255, in each 128-bit group:
-    // corner k (all four channels), or the alpha codes of the four corners.
-    let widen = |pattern: [i32; 4]| {
-        let pattern = _mm512_set4_epi32(pattern[3], pattern[2], pattern[1], pattern[0]);
-        let v = _mm512_shuffle_epi8(codes, pattern);
-        _mm512_mul_ps(_mm512_cvtepi32_ps(v), _mm512_set1_ps(1.0 / 255.0))
-    };
-    // Byte b alone in a 32-bit lane (0x80 bytes read as 0).
-    const fn dw(b: i32) -> i32 {
-        b | (0x80 << 8) | (0x80 << 16) | (0x80 << 24)
-    }
     if lut.colour_linear && (lut.alpha_same || lut.alpha_linear) {
-        return [0, 1, 2, 3]
-            .map(|k| widen([dw(4 * k), dw(4 * k + 1), dw(4 * k + 2), dw(4 * k + 3)]));
+        return [
+            widen(codes, [dw(0), dw(1), dw(2), dw(3)]),
+            widen(codes, [dw(4), dw(5), dw(6), dw(7)]),
+            widen(codes, [dw(8), dw(9), dw(10), dw(11)]),
+            widen(codes, [dw(12), dw(13), dw(14), dw(15)]),
+        ];
     }
     let top7 = _mm512_movepi8_mask(codes);
     // Bytes 3, 7, 11, … are alpha codes.
     const ALPHA: u64 = 0x8888_8888_8888_8888;
     let planes_alpha = !lut.alpha_same && !lut.alpha_linear;
-    let p: [__m512i; 4] = std::array::from_fn(|k| {
-        let c = look_bytes(codes, top7, &lut.planes[0][k]);
+    let mut p = [_mm512_setzero_si512(); 4];
+    for (k, p) in p.iter_mut().enumerate() {
+        *p = look_bytes(codes, top7, &lut.planes[0][k]);
         if planes_alpha {
-            _mm512_mask_blend_epi8(ALPHA, c, look_bytes(codes, top7, &lut.planes[1][k]))
-        } else {
-            c
+            let a = look_bytes(codes, top7, &lut.planes[1][k]);
+            *p = _mm512_mask_blend_epi8(ALPHA, *p, a);
         }
-    });
+    }
     // Within each 128-bit group (one lane's 16 codes): bytes 0-1 and 2-3
     // of each f32, then the f32s of codes 0-3, 4-7, 8-11 and 12-15.
     let a = _mm512_unpacklo_epi8(p[0], p[1]);
@@ -315,7 +342,7 @@ unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
         // Alphas of corners 00, 10, 01, 11; float 3 of each group of
         // corner k takes alpha k.
         const ALPHA16: u16 = 0x8888;
-        let al = widen([dw(3), dw(7), dw(11), dw(15)]);
+        let al = widen(codes, [dw(3), dw(7), dw(11), dw(15)]);
         [
             _mm512_mask_shuffle_ps::<0b00_00_00_00>(d[0], ALPHA16, al, al),
             _mm512_mask_shuffle_ps::<0b01_01_01_01>(d[1], ALPHA16, al, al),
@@ -327,6 +354,18 @@ unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
     }
 }
 
+/// Two 32-byte rows in one register.
+///
+/// # Safety
+/// The addresses satisfy [`read`] for 32 bytes.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+unsafe fn pair(a: u64, b: u64) -> __m512 {
+    // SAFETY: the caller's contract.
+    let (x, y) = unsafe { (read::<__m256>(a), read::<__m256>(b)) };
+    _mm512_insertf32x8::<1>(_mm512_castps256_ps512(x), y)
+}
+
 /// [`group_rgba8`] for an RGBA `f32` chain: two 32-byte loads per lane.
 ///
 /// # Safety
@@ -335,13 +374,15 @@ unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 unsafe fn group_f32(top: &[u64], bot: &[u64]) -> [__m512; 4] {
     // Two lanes' rows [t0 t1 | t0' t1'] per register.
-    let pair = |r: &[u64], j: usize| {
-        // SAFETY: the caller's contract.
-        let (x, y) = unsafe { (read::<__m256>(r[j]), read::<__m256>(r[j + 1])) };
-        _mm512_insertf32x8::<1>(_mm512_castps256_ps512(x), y)
+    // SAFETY: the caller's contract.
+    let (t01, t23, b01, b23) = unsafe {
+        (
+            pair(top[0], top[1]),
+            pair(top[2], top[3]),
+            pair(bot[0], bot[1]),
+            pair(bot[2], bot[3]),
+        )
     };
-    let (t01, t23) = (pair(top, 0), pair(top, 2));
-    let (b01, b23) = (pair(bot, 0), pair(bot, 2));
     [
         _mm512_shuffle_f32x4::<0b10_00_10_00>(t01, t23),
         _mm512_shuffle_f32x4::<0b11_01_11_01>(t01, t23),
@@ -441,14 +482,16 @@ fn fields(qs: &[Query; 8]) -> [__m512d; 6] {
             _mm512_loadu_ps(p.add(32)),
         ]
     };
-    std::array::from_fn(|f| {
+    let mut out = [_mm512_setzero_pd(); 6];
+    for (f, out) in out.iter_mut().enumerate() {
         // SAFETY: a load of a 16-lane constant.
         let idx = unsafe { _mm512_loadu_epi32(FIELD_INDEX[f].as_ptr()) };
         let lo_part = _mm512_permutex2var_ps(z[0], idx, z[1]);
         let hi_part = _mm512_permutexvar_ps(idx, z[2]);
         let lanes = _mm512_mask_blend_ps(FIELD_HIGH[f], lo_part, hi_part);
-        _mm512_cvtps_pd(_mm512_castps512_ps256(lanes))
-    })
+        *out = _mm512_cvtps_pd(_mm512_castps512_ps256(lanes));
+    }
+    out
 }
 
 /// Lane i of field f is float 6i + f of eight queries: taken from the
@@ -636,7 +679,10 @@ pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
             (0, None)
         };
         let (top, bot) = addresses(&bh, fast);
-        let second = bl.as_ref().map(|b| addresses(b, two));
+        let second = match &bl {
+            Some(b) => Some(addresses(b, two)),
+            None => None,
+        };
         let omd = _mm256_sub_ps(_mm256_set1_ps(1.0), delta);
         for h in 0..2 {
             // SAFETY: lanes in `fast` are inside their level, the others
@@ -737,17 +783,25 @@ fn probes<P: Pixel>(c: &Chain<P>, ls: &Levels, a: &Addressing, st: &Setup) -> [f
                 _mm512_set1_pd(first as f64),
             );
             let t = _mm512_sub_pd(_mm512_mul_pd(i, step), _mm512_set1_pd(0.5));
-            let along = |c: f64, d: f64| {
-                _mm512_add_pd(_mm512_set1_pd(c), _mm512_mul_pd(t, _mm512_set1_pd(d)))
-            };
-            (along(st.u, st.major[0]), along(st.v, st.major[1]))
+            let (u, v) = (_mm512_set1_pd(st.u), _mm512_set1_pd(st.v));
+            (
+                _mm512_add_pd(u, _mm512_mul_pd(t, _mm512_set1_pd(st.major[0]))),
+                _mm512_add_pd(v, _mm512_mul_pd(t, _mm512_set1_pd(st.major[1]))),
+            )
         };
         let live = ((1u16 << lanes) - 1) as u8;
         let bh = blocks::<P>(ls, hi, pu, pv);
-        let bl = two.then(|| blocks::<P>(ls, lo, pu, pv));
+        let bl = if two {
+            Some(blocks::<P>(ls, lo, pu, pv))
+        } else {
+            None
+        };
         let fast = live & bh.inside & bl.as_ref().map_or(0xFF, |b| b.inside);
         let (top, bot) = addresses(&bh, fast);
-        let second = bl.as_ref().map(|b| addresses(b, fast));
+        let second = match &bl {
+            Some(b) => Some(addresses(b, fast)),
+            None => None,
+        };
         let mut p = [[0f32; 4]; 8];
         for h in 0..lanes.div_ceil(4) as usize {
             // SAFETY: lanes in `fast` are inside their level, the others
