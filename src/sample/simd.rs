@@ -679,6 +679,8 @@ pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
             (0, None)
         };
         let (top, bot) = addresses(&bh, fast);
+        // Not `Option::map`: a closure would not get the target features.
+        #[allow(clippy::manual_map)]
         let second = match &bl {
             Some(b) => Some(addresses(b, two)),
             None => None,
@@ -798,6 +800,8 @@ fn probes<P: Pixel>(c: &Chain<P>, ls: &Levels, a: &Addressing, st: &Setup) -> [f
         };
         let fast = live & bh.inside & bl.as_ref().map_or(0xFF, |b| b.inside);
         let (top, bot) = addresses(&bh, fast);
+        // Not `Option::map`: a closure would not get the target features.
+        #[allow(clippy::manual_map)]
         let second = match &bl {
             Some(b) => Some(addresses(b, fast)),
             None => None,
