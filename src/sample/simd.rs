@@ -198,9 +198,12 @@ fn blocks<P: Pixel>(ls: &Levels, lvl: __m512i, u: __m512d, v: __m512d) -> Blocks
     let j0 = _mm512_cvttpd_epi64(fy);
     let inside = _mm512_cmplt_epu64_mask(i0, look_epi64(&ls.wm1, lvl))
         & _mm512_cmplt_epu64_mask(j0, look_epi64(&ls.hm1, lvl));
-    let k = _mm512_add_epi64(_mm512_mullo_epi64(j0, look_epi64(&ls.w, lvl)), i0);
-    let size = _mm512_set1_epi64(std::mem::size_of::<P>() as i64);
-    let top = _mm512_add_epi64(look_epi64(&ls.base, lvl), _mm512_mullo_epi64(k, size));
+    // Lanes inside the level have 0 ≤ i0, j0 and w below 2^32, so a
+    // 32 × 32 → 64-bit multiply gives j0·w (other lanes' addresses are
+    // replaced before use). The texel size is a power of two: a shift.
+    let k = _mm512_add_epi64(_mm512_mul_epu32(j0, look_epi64(&ls.w, lvl)), i0);
+    let shift = _mm512_set1_epi64(std::mem::size_of::<P>().trailing_zeros() as i64);
+    let top = _mm512_add_epi64(look_epi64(&ls.base, lvl), _mm512_sllv_epi64(k, shift));
     Blocks {
         top,
         bot: _mm512_add_epi64(top, look_epi64(&ls.row, lvl)),
