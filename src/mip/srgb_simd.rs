@@ -5,32 +5,36 @@
 //! three encode buckets per output texel), and AVX2 gathers are slow on the
 //! machines we measure on. This kernel does no gathers:
 //!
-//! - **Decode without gathers.** Each decoded value (2^-24 units, at most
-//!   2^24) is split into three byte planes. A 256-entry byte table is four
-//!   zmm registers: `vpermi2b` looks up 64 codes in the lower or the upper
-//!   128 entries, and bit 7 of each code picks one of the two results. Code
-//!   255 (exactly 2^24) has the high plane 16 and weight 16 in the sum
-//!   below, so every plane stays a byte.
-//! - **Sum with VNNI.** The source bytes are first permuted so that each
-//!   dword holds one channel of the four source texels of one output texel;
-//!   `vpdpbusd` then sums a plane of the four in one instruction, and two
-//!   shifts combine the planes: the exact `u32` sum `s` of the scalar code.
+//! - **Decode by byte shuffles.** Each decoded value (2^-24 units) is split
+//!   into three byte planes; a 256-entry plane is four zmm registers, and
+//!   four `vpermb` (one per quarter, each merged into the codes at or above
+//!   its start) look it up for 64 codes. Code 255 (exactly 2^24, one bit
+//!   too many) is stored as 2^24 − 1; see `encode` for why that is exact.
+//! - **Sum with VNNI.** The source bytes are first permuted (`vpermi2b`) so
+//!   that each dword holds one channel of the four source texels of one
+//!   output texel; `vpdpbusd` then sums a plane of the four in one
+//!   instruction, and two shifts combine the planes into the `u32` sum `s`
+//!   of the scalar code.
 //! - **Encode by formula, settled exactly.** `s` (2^-26 units) goes through
-//!   the sRGB encode in f32: the linear segment near black, else
-//!   `1.055·x^(5/12) − 0.055` with `x^(5/12)` as a per-octave scale (one
-//!   `vpermps` from the float exponent) times a degree-6 polynomial in the
-//!   mantissa. The code is rounded in 1/65536 steps with an offset of
-//!   `AMBIGUITY` steps, so a result whose fraction is less than
-//!   `2·AMBIGUITY` steps above a code boundary may be off by one: those
-//!   lanes (about 1 in 2000 for random data, found by one `vptestnmd`) are
-//!   redone with the scalar [`FixedSrgb::encode4`]; every other lane is the
+//!   the sRGB encode in f32: the linear segment near black (exact there),
+//!   else `1.055·x^(5/12) − 0.055` with `x^(5/12)` as a per-octave scale
+//!   (one `vpermps` from the float exponent) times a degree-6 polynomial in
+//!   the mantissa. The code is rounded down in 1/65536 steps after adding
+//!   `AMBIGUITY` steps, so a result whose fraction is below `2·AMBIGUITY`
+//!   steps may be one too high: those lanes (1 in 2000 of all sums) are
+//!   redone with the scalar [`FixedSrgb::encode4`]. Every other lane is the
 //!   scalar code, which a unit test checks for every `s` in 0..=2^26.
 //! - Alpha is the rounded linear average `(a + b + c + d + 2) >> 2`, and the
 //!   kernel notes whether any alpha differs from the row's first alpha, so
 //!   the straight-alpha fix-up needs no scan of its own.
+//! - The loop is software-pipelined: the sums of one block of 16 output
+//!   texels are formed while the previous block is encoded (each half is a
+//!   long dependency chain; the overlap is worth about 10%).
 //!
-//! Used when the CPU has AVX-512 F/BW/VBMI/VNNI (detected once at run time)
-//! and `PARVO_NO_AVX` is not set; otherwise the scalar kernel runs.
+//! Used when the CPU has AVX-512 F/BW/DQ/VBMI/VNNI (detected once at run
+//! time) and `PARVO_NO_AVX` is not set; otherwise the scalar kernel runs.
+//! Rows narrower than one block, and the last `width mod 16` texels of a
+//! row, use the scalar kernel too.
 
 use super::fast::{FixedSrgb, row_u8_srgb_n};
 
@@ -71,10 +75,11 @@ pub fn row_rgba8(r0: &[u8], r1: &[u8], dst: &mut [u8], t: &FixedSrgb, avx512: bo
     false
 }
 
-/// Offset, in 1/65536 of a code, added before rounding; lanes whose
-/// rounded value lies within `2·AMBIGUITY` steps above a code boundary are
-/// redone exactly. It must exceed the f32 evaluation error (about 7 steps,
-/// see the exhaustive test) and be a power of two (the test is one mask).
+/// Offset, in 1/65536 of a code, added before rounding down; lanes whose
+/// result lies less than `2·AMBIGUITY` steps above a code boundary are
+/// redone exactly. It must exceed the f32 evaluation error (the
+/// polynomial's bound is about 7 steps; 4 already passes the exhaustive
+/// test, 16 leaves a margin and redoes 1 sum in 2000).
 const AMBIGUITY: u32 = 16;
 
 /// `m^(5/12)` for `m` in [1, 2): the degree-6 Chebyshev interpolant,
@@ -187,6 +192,7 @@ mod x86 {
         split: __m512i,
         ambiguous: __m512i,
         ones: __m512i,
+        bit6: __m512i,
     }
 
     #[target_feature(enable = "avx512f,avx512bw,avx512vbmi,avx512vnni")]
@@ -217,17 +223,20 @@ mod x86 {
             split: _mm512_set1_epi32(LINEAR_BELOW as i32),
             ambiguous: _mm512_set1_epi32((0xFFFF & !(2 * AMBIGUITY - 1)) as i32),
             ones: _mm512_set1_epi8(1),
+            bit6: _mm512_set1_epi8(0x40),
         }
     }
 
     /// One 256-entry byte table (four registers) looked up for 64 codes:
-    /// the codes with bit 7 set first, in place (the others keep their
-    /// code), then the rest in the lower half, in place again.
+    /// `vpermb` on the low six bits, each quarter of the table merged
+    /// into the codes at or above its start (`from`).
     #[inline]
     #[target_feature(enable = "avx512f,avx512bw,avx512vbmi")]
-    fn look_up(table: &[__m512i; 4], codes: __m512i, high: __mmask64) -> __m512i {
-        let r = _mm512_mask2_permutex2var_epi8(table[2], codes, high, table[3]);
-        _mm512_mask2_permutex2var_epi8(table[0], r, !high, table[1])
+    fn look_up(table: &[__m512i; 4], codes: __m512i, from: [__mmask64; 3]) -> __m512i {
+        let r = _mm512_permutexvar_epi8(codes, table[0]);
+        let r = _mm512_mask_permutexvar_epi8(r, from[0], codes, table[1]);
+        let r = _mm512_mask_permutexvar_epi8(r, from[1], codes, table[2]);
+        _mm512_mask_permutexvar_epi8(r, from[2], codes, table[3])
     }
 
     /// Sum of the decoded values of the four bytes of each dword (2^-24
@@ -238,10 +247,13 @@ mod x86 {
     #[inline]
     #[target_feature(enable = "avx512f,avx512bw,avx512vbmi,avx512vnni")]
     fn sum4(k: &Consts, q: __m512i) -> __m512i {
-        let high = _mm512_movepi8_mask(q);
-        let lo = look_up(&k.planes[0], q, high);
-        let mid = look_up(&k.planes[1], q, high);
-        let hi = look_up(&k.planes[2], q, high);
+        let b7 = _mm512_movepi8_mask(q);
+        let b6 = _mm512_test_epi8_mask(q, k.bit6);
+        // Codes from 64, from 128, from 192: each look-up overwrites.
+        let quarters = [b7 | b6, b7, b7 & b6];
+        let lo = look_up(&k.planes[0], q, quarters);
+        let mid = look_up(&k.planes[1], q, quarters);
+        let hi = look_up(&k.planes[2], q, quarters);
         // (Σhigh·2^8 + Σmid)·2^8 + Σlow.
         let s = _mm512_dpbusd_epi32(_mm512_setzero_si512(), hi, k.ones);
         let s = _mm512_dpbusd_epi32(_mm512_slli_epi32::<8>(s), mid, k.ones);
