@@ -31,7 +31,7 @@
 //!   texels are formed while the previous block is encoded (each half is a
 //!   long dependency chain; the overlap is worth about 10%).
 //!
-//! Used when the CPU has AVX-512 F/BW/DQ/VBMI/VNNI (detected once at run
+//! Used when the CPU has AVX-512 F/BW/VBMI/VNNI (detected once at run
 //! time) and `PARVO_NO_AVX` is not set; otherwise the scalar kernel runs.
 //! Rows narrower than one block, and the last `width mod 16` texels of a
 //! row, use the scalar kernel too.
@@ -66,8 +66,9 @@ pub fn row_rgba8(r0: &[u8], r1: &[u8], dst: &mut [u8], t: &FixedSrgb, avx512: bo
     if avx512 {
         assert!(supported(), "AVX-512 kernel requested on a CPU without it");
         #[allow(unsafe_code)]
-        // SAFETY: `detected()` has just confirmed AVX-512 F, BW, VBMI and
-        // VNNI, the features `x86::row` is compiled for.
+        // SAFETY: the assert above (`supported()`) confirmed AVX-512 F, BW,
+        // VBMI and VNNI, the features `x86::row` is compiled for. The
+        // kernel reads and writes only through slices (64-byte arrays).
         return unsafe { x86::row(r0, r1, dst, t, x86::tables(t)) };
     }
     let _ = avx512;
@@ -331,31 +332,29 @@ mod x86 {
         (idx, first_pair)
     }
 
-    /// Output byte `i` (texel `i / 4`, channel `i % 4`) from byte 2 of a
-    /// colour dword (the code) or byte 1 of an alpha dword; lanes in the
-    /// mask read (colour 0, colour 1), the others (colour 2, alpha).
-    const fn pack() -> ([u8; 64], u64) {
-        let (mut idx, mut first_pair) = ([0u8; 64], 0u64);
+    /// Output byte `i` (texel `i / 4`, channel `i % 4`) from the merged
+    /// register of `row`: dword `l` holds lane `l` of colour register 1 in
+    /// byte 0, of the alpha register in byte 1, of colour register 0 in
+    /// byte 2 and of colour register 2 in byte 3.
+    const fn pack() -> [u8; 64] {
+        let mut idx = [0u8; 64];
         let mut i = 0;
         while i < 64 {
             let (texel, channel) = (i / 4, i % 4);
-            let (reg, byte) = if channel < 3 {
+            let (lane, byte) = if channel < 3 {
                 let v = 3 * texel + channel;
-                (v / 16, 4 * (v % 16) + 2)
+                (v % 16, [2, 0, 3][v / 16])
             } else {
-                (3, 4 * texel + 1)
+                (texel, 1)
             };
-            idx[i] = ((reg % 2) * 64 + byte) as u8;
-            if reg < 2 {
-                first_pair |= 1 << i;
-            }
+            idx[i] = (4 * lane + byte) as u8;
             i += 1;
         }
-        (idx, first_pair)
+        idx
     }
 
     const GATHER: [([u8; 64], u64); 4] = [gather(0), gather(1), gather(2), gather(3)];
-    const PACK: ([u8; 64], u64) = pack();
+    const PACK: [u8; 64] = pack();
 
     /// Gather indices and the alpha constants, as registers.
     struct Gather {
@@ -415,11 +414,13 @@ mod x86 {
         ]
     }
 
+    /// The kernel behind [`super::row_rgba8`]: blocks of 16 output texels,
+    /// then the scalar kernel for the rest of the row.
     #[target_feature(enable = "avx512f,avx512bw,avx512vbmi,avx512vnni")]
     pub fn row(r0: &[u8], r1: &[u8], dst: &mut [u8], t: &FixedSrgb, tab: &Tables) -> bool {
         let k = consts(tab);
         let g = Gather::new(r0[3]);
-        let (pack, pack_first) = (load(&PACK.0), PACK.1);
+        let pack = load(&PACK);
         let mut diff = _mm512_setzero_si512();
 
         let a_blocks = r0.as_chunks::<64>().0;
@@ -446,8 +447,12 @@ mod x86 {
             let (n0, m0) = encode(&k, s0);
             let (n1, m1) = encode(&k, s1);
             let (n2, m2) = encode(&k, s2);
-            let out = _mm512_mask2_permutex2var_epi8(n0, pack, pack_first, n1);
-            let out = _mm512_mask2_permutex2var_epi8(n2, out, !pack_first, na);
+            // One register of dwords [code 1, alpha, code 0, code 2] (codes
+            // are byte 2 of n, alpha byte 1 of na), then one shuffle.
+            let x = _mm512_mask_blend_epi8(0x1111_1111_1111_1111, n0, _mm512_srli_epi32::<16>(n1));
+            let x = _mm512_mask_blend_epi8(0x2222_2222_2222_2222, x, na);
+            let x = _mm512_mask_blend_epi8(0x8888_8888_8888_8888, x, _mm512_slli_epi32::<8>(n2));
+            let out = _mm512_permutexvar_epi8(pack, x);
             store(d, out);
             if m0 | m1 | m2 != 0 {
                 let ambiguous = m0 as u64 | (m1 as u64) << 16 | (m2 as u64) << 32;
@@ -455,7 +460,7 @@ mod x86 {
                 redo_ambiguous(a.as_flattened(), b.as_flattened(), d, ambiguous, t);
             }
         }
-        let done = dst.len() / 64 * 64;
+        let done = 64 * n;
         let mut constant = _mm512_test_epi32_mask(diff, diff) == 0;
         if done < dst.len() {
             let (t0, t1) = (&r0[2 * done..], &r1[2 * done..]);
