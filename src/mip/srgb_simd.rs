@@ -273,7 +273,7 @@ mod x86 {
     /// `SHORT_FROM` on has the scalar code of `s + 1` to `s + 4` too.
     ///
     /// Lanes in the linear segment are never flagged: there the f32 value
-    /// is within 0.02 of a step of the exact one, no integer sum comes
+    /// is within 0.04 of a step of the exact one, no integer sum comes
     /// closer than 0.08 steps to a threshold (the same exhaustive test),
     /// and sums of dark codes often tie exactly in linear light (codes 0,
     /// 1, 0, 1 average to 0.5), which a window would send to the scalar
