@@ -28,7 +28,7 @@ use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
-use super::{MipFilter, MipOptions};
+use super::{MipFilter, MipOptions, srgb_simd};
 use crate::error::Result;
 use crate::texel::{AlphaMode, ColorSpace, Format, Texels, srgb};
 use crate::texture::Texture;
@@ -78,6 +78,20 @@ fn rows_per_task(row_bytes: usize) -> usize {
 
 /// 2×2 box of an even-sized u8 level (linear or sRGB).
 pub fn box_u8(src: &[u8], sw: usize, fmt: Format, straight: Option<usize>, srgb: bool) -> Vec<u8> {
+    box_u8_with(src, sw, fmt, straight, srgb, srgb_simd::available())
+}
+
+/// [`box_u8`] with the sRGB RGBA8 kernel chosen by the caller: the AVX-512
+/// one when `avx512` (the CPU must have it), else the scalar one. Lets the
+/// tests compare both in one process without touching `PARVO_NO_AVX`.
+fn box_u8_with(
+    src: &[u8],
+    sw: usize,
+    fmt: Format,
+    straight: Option<usize>,
+    srgb: bool,
+    avx512: bool,
+) -> Vec<u8> {
     let ch = fmt.channels as usize;
     let (w, h) = (sw / 2, src.len() / (sw * ch) / 2);
     let row = w * ch;
@@ -101,6 +115,7 @@ pub fn box_u8(src: &[u8], sw: usize, fmt: Format, straight: Option<usize>, srgb:
                         }
                         false
                     }
+                    (Some(t), 4) => srgb_simd::row_rgba8(r0, r1, d, t, avx512),
                     (Some(t), _) => {
                         row_u8_srgb(r0, r1, d, fmt, t);
                         false
@@ -320,7 +335,7 @@ const BUCKETS: usize = 8192;
 /// threshold; the 4097 buckets in use (16 KiB) stay in the L1 cache.
 const BUCKET_SHIFT: u32 = 14;
 
-fn fixed_tables() -> &'static FixedSrgb {
+pub(super) fn fixed_tables() -> &'static FixedSrgb {
     static T: OnceLock<FixedSrgb> = OnceLock::new();
     T.get_or_init(|| {
         let mut dec = [0u32; 256];
@@ -355,13 +370,24 @@ fn fixed_tables() -> &'static FixedSrgb {
 }
 
 impl FixedSrgb {
+    /// Decoded value of each code, 2^-24 units (code 255 is exactly 2^24).
+    pub(super) fn dec(&self) -> &[u32; 256] {
+        &self.dec
+    }
+
+    /// The 255 decision thresholds (2^-26 units), then `u32::MAX`.
+    #[cfg(test)]
+    pub(super) fn thr(&self) -> &[u32; 256] {
+        &self.thr
+    }
+
     /// Code of a sum of four decoded values (2^-26 units of linear light).
     ///
     /// Thresholds are at least 20369 units apart (the steepest part of
     /// the curve, near 0) and buckets 16384 wide, so the bucket's code is
     /// at most one below the answer: one comparison, no loop.
     #[inline(always)]
-    fn encode4(&self, s: u32) -> u8 {
+    pub(super) fn encode4(&self, s: u32) -> u8 {
         let e = self.bucket[(s >> BUCKET_SHIFT) as usize & (BUCKETS - 1)];
         let within = s & ((1 << BUCKET_SHIFT) - 1);
         e as u8 + u8::from(within >= e >> 8)
@@ -380,7 +406,7 @@ fn row_u8_srgb(r0: &[u8], r1: &[u8], dst: &mut [u8], fmt: Format, t: &FixedSrgb)
 /// `CH` channels of which the first `CC` are colour (the rest, if any, is
 /// a linear alpha channel).
 #[inline(always)]
-fn row_u8_srgb_n<const CH: usize, const CC: usize>(
+pub(super) fn row_u8_srgb_n<const CH: usize, const CC: usize>(
     r0: &[u8],
     r1: &[u8],
     dst: &mut [u8],
@@ -584,6 +610,65 @@ fn row_f32_straight(r0: &[f32], r1: &[f32], dst: &mut [f32], ch: usize, a: usize
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::texel::ChannelType;
+
+    /// Every level of a box chain, reduced with the AVX-512 sRGB kernel or
+    /// the scalar one (the same choice `PARVO_NO_AVX` makes, without the
+    /// environment).
+    fn box_chain(level0: &[u8], w: usize, h: usize, fmt: Format, avx512: bool) -> Vec<Vec<u8>> {
+        let straight = fmt
+            .alpha_channel()
+            .filter(|_| fmt.alpha == AlphaMode::Straight);
+        let (mut levels, mut w, mut h) = (vec![level0.to_vec()], w, h);
+        while w % 2 == 0 && h % 2 == 0 && w * h > 1 {
+            let src = levels.last().expect("level 0");
+            levels.push(box_u8_with(src, w, fmt, straight, true, avx512));
+            (w, h) = (w / 2, h / 2);
+        }
+        levels
+    }
+
+    #[test]
+    fn avx512_and_scalar_srgb_box_chains_are_identical() {
+        if !srgb_simd::supported() {
+            eprintln!("skipped: no AVX-512 F/BW/VBMI/VNNI on this CPU");
+            return;
+        }
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut byte = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 32) as u8
+        };
+        // Random colour; alpha opaque in the top third, random in the
+        // middle, constant per 8×8 tile below (so some rows have constant,
+        // non-255 alpha and some blocks straddle tiles).
+        for (w, h) in [(512usize, 256usize), (260, 24), (2, 2), (96, 2)] {
+            let mut level0 = vec![0u8; w * h * 4];
+            for (i, px) in level0.chunks_exact_mut(4).enumerate() {
+                let (x, y) = (i % w, i / w);
+                px[..3].iter_mut().for_each(|c| *c = byte());
+                px[3] = match 3 * y / h {
+                    0 => 255,
+                    1 => byte(),
+                    _ => (x / 8 * 37 + y / 8 * 101) as u8,
+                };
+            }
+            for alpha in [AlphaMode::Straight, AlphaMode::Premultiplied] {
+                let fmt = Format {
+                    alpha,
+                    ..Format::new(4, ChannelType::U8, ColorSpace::Srgb)
+                };
+                let fast = box_chain(&level0, w, h, fmt, true);
+                let plain = box_chain(&level0, w, h, fmt, false);
+                assert!(fast.len() > 1, "{w}×{h} has a reduced level");
+                for (k, (a, b)) in fast.iter().zip(&plain).enumerate() {
+                    assert!(a == b, "{w}×{h} {alpha:?}: level {k} differs");
+                }
+            }
+        }
+    }
 
     #[test]
     fn one_step_encode_equals_the_threshold_count_everywhere() {

@@ -26,6 +26,7 @@ pub mod kernel;
 pub mod nan;
 pub mod normal;
 pub mod separable;
+mod srgb_simd;
 pub mod weights;
 
 use std::fmt;
