@@ -239,7 +239,7 @@ mod avx {
     pub fn available() -> bool {
         static OK: OnceLock<bool> = OnceLock::new();
         *OK.get_or_init(|| {
-            std::env::var_os("PARVO_NO_AVX").is_none()
+            crate::cpu::simd_allowed()
                 && is_x86_feature_detected!("avx2")
                 && is_x86_feature_detected!("fma")
         })

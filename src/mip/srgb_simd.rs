@@ -41,9 +41,7 @@ use super::fast::{FixedSrgb, row_u8_srgb_n};
 /// True when the AVX-512 kernel may run: the CPU has the features and
 /// `PARVO_NO_AVX` is not set (read once).
 pub fn available() -> bool {
-    use std::sync::OnceLock;
-    static OK: OnceLock<bool> = OnceLock::new();
-    *OK.get_or_init(|| std::env::var_os("PARVO_NO_AVX").is_none() && supported())
+    crate::cpu::simd_allowed() && supported()
 }
 
 /// True when this CPU has what the AVX-512 kernel needs (whatever

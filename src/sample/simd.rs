@@ -53,7 +53,7 @@ use super::{Query, SamplerOptions, aniso};
 pub(crate) fn available() -> bool {
     static OK: OnceLock<bool> = OnceLock::new();
     *OK.get_or_init(|| {
-        std::env::var_os("PARVO_NO_AVX").is_none()
+        crate::cpu::simd_allowed()
             && is_x86_feature_detected!("avx512f")
             && is_x86_feature_detected!("avx512bw")
             && is_x86_feature_detected!("avx512dq")
