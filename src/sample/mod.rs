@@ -527,6 +527,9 @@ pub struct Sampler {
     addr: Addressing,
     lod: Lod,
     sat: Option<Arc<SatSampler>>,
+    /// The chain's level table for the AVX-512 path, when it can run.
+    #[cfg(target_arch = "x86_64")]
+    simd: Option<simd::LevelTable>,
 }
 
 impl Sampler {
@@ -575,6 +578,11 @@ impl Sampler {
         };
         let (wf, hf) = chain.size0();
         let lod = Lod::new(&options, wf, hf, chain.len());
+        #[cfg(target_arch = "x86_64")]
+        let simd = match &chain.store {
+            Store::Rgba8(c) => simd::LevelTable::new(c),
+            Store::F32(c) => simd::LevelTable::new(c),
+        };
         Ok(Sampler {
             chain,
             options,
@@ -585,6 +593,8 @@ impl Sampler {
             },
             lod,
             sat: None,
+            #[cfg(target_arch = "x86_64")]
+            simd,
         })
     }
 
@@ -600,15 +610,10 @@ impl Sampler {
             use TexelFilter::Linear;
             let o = &self.options;
             let kernel = matches!(self.kernel, Kernel::Isotropic | Kernel::Texel);
-            let fits = match &self.chain.store {
-                Store::Rgba8(c) => simd::fits(c),
-                Store::F32(c) => simd::fits(c),
-            };
             kernel
                 && (o.mag, o.min) == (Linear, Linear)
                 && o.mip != MipMode::None
-                && simd::available()
-                && fits
+                && self.simd.is_some()
         }
         #[cfg(not(target_arch = "x86_64"))]
         false
@@ -723,21 +728,23 @@ impl Sampler {
         sink: &mut S,
     ) {
         let (a, lod, o) = (&self.addr, &self.lod, &self.options);
+        // Isotropic lookups go 8 at a time: fewer take the portable path
+        // directly.
         #[cfg(target_arch = "x86_64")]
-        if !S::TRACES
+        if let Some(table) = &self.simd
+            && !S::TRACES
             && F::LINEAR
             && MIP != trilinear::MIP_NONE
-            && simd::available()
-            && simd::fits(c)
+            && (ANISO || queries.len() >= 8)
         {
-            // SAFETY: `available` checked the CPU features and `fits` the
-            // chain, the two conditions of both functions.
+            // SAFETY: `self.simd` is `LevelTable::new` of this sampler's
+            // chain, `c` (see `Sampler::build`).
             #[allow(unsafe_code)]
             unsafe {
                 if ANISO {
-                    simd::anisotropic::<P, MIP>(c, a, lod, o, queries, out);
+                    simd::anisotropic::<P, MIP>(c, table, a, lod, o, queries, out);
                 } else {
-                    simd::isotropic::<P, MIP>(c, a, lod, o, queries, out);
+                    simd::isotropic::<P, MIP>(c, table, a, lod, o, queries, out);
                 }
             }
             return;

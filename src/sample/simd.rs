@@ -92,37 +92,57 @@ struct Levels {
     row: [__m512i; 2],
 }
 
+/// The per-level constants of a chain as plain arrays (index = level),
+/// worked out once per sampler; [`Levels`] loads them into registers.
+/// The addresses stay valid while the chain lives: the sampler that owns
+/// this table owns the chain (through an `Arc`), whose level buffers never
+/// move.
+#[derive(Clone, Debug)]
+pub(crate) struct LevelTable {
+    wf: [f64; 16],
+    hf: [f64; 16],
+    /// `w − 1`, `h − 1`, `w`, the level's address, bytes per row.
+    int: [[i64; 16]; 5],
+}
+
+impl LevelTable {
+    /// The table of `c`, or `None` when these paths cannot run on it
+    /// (not [`available`], or `c` does not [`fits`]).
+    pub(crate) fn new<P: Pixel>(c: &Chain<P>) -> Option<LevelTable> {
+        if !(available() && fits(c)) {
+            return None;
+        }
+        let mut t = LevelTable {
+            wf: [0.0; 16],
+            hf: [0.0; 16],
+            int: [[0; 16]; 5],
+        };
+        let size = std::mem::size_of::<P>() as i64;
+        for (k, l) in c.levels.iter().enumerate() {
+            t.wf[k] = l.wf;
+            t.hf[k] = l.hf;
+            t.int[0][k] = l.w as i64 - 1;
+            t.int[1][k] = l.h as i64 - 1;
+            t.int[2][k] = l.w as i64;
+            t.int[3][k] = l.texels.as_ptr().expose_provenance() as i64;
+            t.int[4][k] = l.w as i64 * size;
+        }
+        Some(t)
+    }
+}
+
 impl Levels {
     #[inline]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
-    fn new<P: Pixel>(c: &Chain<P>) -> Levels {
-        let (mut wf, mut hf) = ([0f64; 16], [0f64; 16]);
-        let mut int = [[0i64; 16]; 5];
-        let size = std::mem::size_of::<P>() as i64;
-        for (k, l) in c.levels.iter().enumerate().take(MAX_LEVELS) {
-            wf[k] = l.wf;
-            hf[k] = l.hf;
-            int[0][k] = l.w as i64 - 1;
-            int[1][k] = l.h as i64 - 1;
-            int[2][k] = l.w as i64;
-            int[3][k] = l.texels.as_ptr().expose_provenance() as i64;
-            int[4][k] = l.w as i64 * size;
-        }
-        let [wm1, hm1, w, base, row] = [
-            epi64x2(&int[0]),
-            epi64x2(&int[1]),
-            epi64x2(&int[2]),
-            epi64x2(&int[3]),
-            epi64x2(&int[4]),
-        ];
+    fn new(t: &LevelTable) -> Levels {
         Levels {
-            wf: pd2(&wf),
-            hf: pd2(&hf),
-            wm1,
-            hm1,
-            w,
-            base,
-            row,
+            wf: pd2(&t.wf),
+            hf: pd2(&t.hf),
+            wm1: epi64x2(&t.int[0]),
+            hm1: epi64x2(&t.int[1]),
+            w: epi64x2(&t.int[2]),
+            base: epi64x2(&t.int[3]),
+            row: epi64x2(&t.int[4]),
         }
     }
 }
@@ -657,17 +677,19 @@ fn plans<const MIP: u8>(
 /// `trilinear::plan` and `trilinear::probe` compute, 8 queries at a time.
 ///
 /// # Safety
-/// [`available`] is true and [`fits`]`(c)`.
+/// `table` is `LevelTable::new(c)` (which is `Some` only when the CPU has
+/// the features).
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
     c: &Chain<P>,
+    table: &LevelTable,
     a: &Addressing,
     lod: &Lod,
     opts: &SamplerOptions,
     queries: &[Query],
     out: &mut [[f32; 4]],
 ) {
-    let ls = Levels::new(c);
+    let ls = Levels::new(table);
     let mut qs = queries.chunks_exact(8);
     let mut os = out.chunks_exact_mut(8);
     for (q8, o8) in (&mut qs).zip(&mut os) {
@@ -741,17 +763,18 @@ fn portable<P: Pixel, const MIP: u8>(
 /// does it, then the probes 8 at a time.
 ///
 /// # Safety
-/// [`available`] is true and [`fits`]`(c)`.
+/// As [`isotropic`].
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
     c: &Chain<P>,
+    table: &LevelTable,
     a: &Addressing,
     lod: &Lod,
     opts: &SamplerOptions,
     queries: &[Query],
     out: &mut [[f32; 4]],
 ) {
-    let ls = Levels::new(c);
+    let ls = Levels::new(table);
     for (qs, os) in queries
         .chunks(super::BLOCK)
         .zip(out.chunks_mut(super::BLOCK))
