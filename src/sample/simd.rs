@@ -472,12 +472,12 @@ fn lerp16(x: __m512, y: __m512, omt: __m512, t: __m512) -> __m512 {
 /// `lerp(lerp(t00, t10, α), lerp(t01, t11, α), β)`, as `Pixel::bilerp`.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
-fn bilerp(d: [__m512; 4], b: &Blocks, h: usize) -> __m512 {
+fn bilerp(d: [__m512; 4], al8: __m256, be8: __m256, h: usize) -> __m512 {
     let one = _mm256_set1_ps(1.0);
-    let (al, be) = (spread(b.al, h), spread(b.be, h));
+    let (al, be) = (spread(al8, h), spread(be8, h));
     let (oma, omb) = (
-        spread(_mm256_sub_ps(one, b.al), h),
-        spread(_mm256_sub_ps(one, b.be), h),
+        spread(_mm256_sub_ps(one, al8), h),
+        spread(_mm256_sub_ps(one, be8), h),
     );
     lerp16(
         lerp16(d[0], d[1], oma, al),
@@ -672,9 +672,101 @@ fn plans<const MIP: u8>(
     }
 }
 
+/// What the first pass leaves for the second about one block of 8 lanes:
+/// the addresses of each lane's 2×2 block on its one or two levels
+/// ([`ZEROS`] for lanes that are not read there), the fractions and the
+/// level blend.
+///
+/// Splitting the work in two passes keeps each loop's iterations short
+/// and independent, so the core overlaps many of them; one long loop from
+/// query to colour was bound by its own latency.
+#[derive(Clone, Copy)]
+struct Staged {
+    top: [u64; 8],
+    bot: [u64; 8],
+    top2: [u64; 8],
+    bot2: [u64; 8],
+    /// α, β on level `hi`; α, β on level `lo`; δ.
+    w: [[f32; 8]; 5],
+    /// Lanes read here (the others take the portable path).
+    fast: u8,
+    /// Lanes that blend a second level.
+    two: u8,
+}
+
+impl Staged {
+    const EMPTY: Staged = Staged {
+        top: [0; 8],
+        bot: [0; 8],
+        top2: [0; 8],
+        bot2: [0; 8],
+        w: [[0.0; 8]; 5],
+        fast: 0,
+        two: 0,
+    };
+}
+
+/// Blocks staged per chunk of the isotropic path.
+const CHUNK: usize = 8;
+
+/// The addresses and weights of `b` (and `b2` for `two`) into `s`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn stage(s: &mut Staged, b: &Blocks, b2: Option<&Blocks>, delta: __m256, fast: u8, two: u8) {
+    (s.top, s.bot) = addresses(b, fast);
+    // SAFETY: unaligned 32-byte stores into 8-float arrays.
+    unsafe {
+        _mm256_storeu_ps(s.w[0].as_mut_ptr(), b.al);
+        _mm256_storeu_ps(s.w[1].as_mut_ptr(), b.be);
+        _mm256_storeu_ps(s.w[4].as_mut_ptr(), delta);
+    }
+    if let Some(b2) = b2 {
+        (s.top2, s.bot2) = addresses(b2, two);
+        // SAFETY: as above.
+        unsafe {
+            _mm256_storeu_ps(s.w[2].as_mut_ptr(), b2.al);
+            _mm256_storeu_ps(s.w[3].as_mut_ptr(), b2.be);
+        }
+    }
+    s.fast = fast;
+    s.two = two;
+}
+
+/// Loads a staged `[f32; 8]`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn ps8(x: &[f32; 8]) -> __m256 {
+    // SAFETY: an unaligned 32-byte load of the 8-float array.
+    unsafe { _mm256_loadu_ps(x.as_ptr()) }
+}
+
+/// The colours of lanes `4h … 4h + 3` of a staged block: the bilinear
+/// blend on level `hi`, blended with level `lo` for the lanes in `two`
+/// when `MIP` is linear.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn colours<P: Pixel, const MIP: u8>(c: &Chain<P>, s: &Staged, h: usize) -> __m512 {
+    // SAFETY: lanes in `fast` are inside their level, the others read
+    // `ZEROS` (`addresses`).
+    let d = unsafe { group::<P>(&c.lut, &s.top, &s.bot, h) };
+    let r = bilerp(d, ps8(&s.w[0]), ps8(&s.w[1]), h);
+    let m = group_mask(s.two, h);
+    if MIP != MIP_LINEAR || m == 0 {
+        return r;
+    }
+    // SAFETY: as above, with the lanes in `two`.
+    let d2 = unsafe { group::<P>(&c.lut, &s.top2, &s.bot2, h) };
+    let r2 = bilerp(d2, ps8(&s.w[2]), ps8(&s.w[3]), h);
+    let delta = ps8(&s.w[4]);
+    let omd = _mm256_sub_ps(_mm256_set1_ps(1.0), delta);
+    let mixed = lerp16(r, r2, spread(omd, h), spread(delta, h));
+    _mm512_mask_blend_ps(m, r, mixed)
+}
+
 /// Isotropic bilinear or trilinear lookups (`Lin` filters, mip mode
 /// `MIP` nearest or linear) of `queries` into `out`: what
-/// `trilinear::plan` and `trilinear::probe` compute, 8 queries at a time.
+/// `trilinear::plan` and `trilinear::probe` compute, 8 queries at a time,
+/// in two passes over chunks of [`CHUNK`] blocks (see [`Staged`]).
 ///
 /// # Safety
 /// `table` is `LevelTable::new(c)` (which is `Some` only when the CPU has
@@ -690,57 +782,50 @@ pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
     out: &mut [[f32; 4]],
 ) {
     let ls = Levels::new(table);
-    let mut qs = queries.chunks_exact(8);
-    let mut os = out.chunks_exact_mut(8);
-    for (q8, o8) in (&mut qs).zip(&mut os) {
-        let q8: &[Query; 8] = q8.try_into().expect("8 queries");
-        let f = fields(q8);
-        let (hi, lo, delta, ok) = plans::<MIP>(lod, opts, &f);
-        let bh = blocks::<P>(&ls, hi, f[0], f[1]);
-        let mut fast = ok & bh.inside;
-        // Lanes that blend a second level (δ > 0 and a different level).
-        let (two, bl) = if MIP == MIP_LINEAR {
-            let two = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(delta, _mm256_setzero_ps())
-                & _mm512_cmpneq_epi64_mask(lo, hi);
-            let bl = blocks::<P>(&ls, lo, f[0], f[1]);
-            fast &= !two | bl.inside;
-            (two & fast, Some(bl))
-        } else {
-            (0, None)
-        };
-        let (top, bot) = addresses(&bh, fast);
-        // Not `Option::map`: a closure would not get the target features.
-        #[allow(clippy::manual_map)]
-        let second = match &bl {
-            Some(b) => Some(addresses(b, two)),
-            None => None,
-        };
-        let omd = _mm256_sub_ps(_mm256_set1_ps(1.0), delta);
-        for h in 0..2 {
-            // SAFETY: lanes in `fast` are inside their level, the others
-            // read `ZEROS` (`addresses`).
-            let mut r = bilerp(unsafe { group::<P>(&c.lut, &top, &bot, h) }, &bh, h);
-            let m = group_mask(two, h);
-            if let (Some(b), Some((t2, b2))) = (&bl, &second)
-                && m != 0
-            {
-                // SAFETY: as above, with the lanes in `two`.
-                let r2 = bilerp(unsafe { group::<P>(&c.lut, t2, b2, h) }, b, h);
-                let mixed = lerp16(r, r2, spread(omd, h), spread(delta, h));
-                r = _mm512_mask_blend_ps(m, r, mixed);
+    let mut staged = [Staged::EMPTY; CHUNK];
+    let whole = queries.len() / 8 * 8;
+    for (qc, oc) in queries[..whole]
+        .chunks(8 * CHUNK)
+        .zip(out[..whole].chunks_mut(8 * CHUNK))
+    {
+        let nb = qc.len() / 8;
+        for (q8, s) in qc.chunks_exact(8).zip(&mut staged) {
+            let q8: &[Query; 8] = q8.try_into().expect("8 queries");
+            let f = fields(q8);
+            let (hi, lo, delta, ok) = plans::<MIP>(lod, opts, &f);
+            let bh = blocks::<P>(&ls, hi, f[0], f[1]);
+            let mut fast = ok & bh.inside;
+            if MIP == MIP_LINEAR {
+                // Lanes that blend a second level (δ > 0 and a different
+                // level).
+                let two = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(delta, _mm256_setzero_ps())
+                    & _mm512_cmpneq_epi64_mask(lo, hi);
+                let bl = blocks::<P>(&ls, lo, f[0], f[1]);
+                fast &= !two | bl.inside;
+                stage(s, &bh, Some(&bl), delta, fast, two & fast);
+            } else {
+                stage(s, &bh, None, delta, fast, 0);
             }
-            // SAFETY: one unaligned 64-byte store into 4 RGBA values.
-            unsafe { _mm512_storeu_ps(o8[4 * h..].as_mut_ptr().cast(), r) };
         }
-        if fast != 0xFF {
-            for (i, (q, o)) in q8.iter().zip(o8.iter_mut()).enumerate() {
-                if fast >> i & 1 == 0 {
-                    *o = portable::<P, MIP>(c, a, lod, opts, q);
+        for (s, o8) in staged[..nb].iter().zip(oc.chunks_exact_mut(8)) {
+            for h in 0..2 {
+                let r = colours::<P, MIP>(c, s, h);
+                // SAFETY: one unaligned 64-byte store into 4 RGBA values.
+                unsafe { _mm512_storeu_ps(o8[4 * h..].as_mut_ptr().cast(), r) };
+            }
+        }
+        for (b, (s, o8)) in staged[..nb].iter().zip(oc.chunks_exact_mut(8)).enumerate() {
+            if s.fast != 0xFF {
+                let q8 = &qc[8 * b..8 * b + 8];
+                for (i, (q, o)) in q8.iter().zip(o8.iter_mut()).enumerate() {
+                    if s.fast >> i & 1 == 0 {
+                        *o = portable::<P, MIP>(c, a, lod, opts, q);
+                    }
                 }
             }
         }
     }
-    for (q, o) in qs.remainder().iter().zip(os.into_remainder()) {
+    for (q, o) in queries[whole..].iter().zip(&mut out[whole..]) {
         *o = portable::<P, MIP>(c, a, lod, opts, q);
     }
 }
@@ -841,10 +926,15 @@ fn probes<P: Pixel>(c: &Chain<P>, ls: &Levels, a: &Addressing, st: &Setup) -> [f
         for h in 0..lanes.div_ceil(4) as usize {
             // SAFETY: lanes in `fast` are inside their level, the others
             // read `ZEROS` (`addresses`).
-            let mut r = bilerp(unsafe { group::<P>(&c.lut, &top, &bot, h) }, &bh, h);
+            let mut r = bilerp(
+                unsafe { group::<P>(&c.lut, &top, &bot, h) },
+                bh.al,
+                bh.be,
+                h,
+            );
             if let (Some(b), Some((t2, b2))) = (&bl, &second) {
                 // SAFETY: as above.
-                let r2 = bilerp(unsafe { group::<P>(&c.lut, t2, b2, h) }, b, h);
+                let r2 = bilerp(unsafe { group::<P>(&c.lut, t2, b2, h) }, b.al, b.be, h);
                 r = lerp16(r, r2, omd, delta);
             }
             // SAFETY: one unaligned 64-byte store into 4 RGBA values.
