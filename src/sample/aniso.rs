@@ -38,6 +38,14 @@ pub(crate) struct Setup {
 }
 
 impl Setup {
+    /// Position of probe `i` (1 ≤ i ≤ `probes`) with `step` = 1/(probes + 1):
+    /// `centre + (i·step − 1/2)·major` (SPEC.md "Anisotropic probes").
+    #[inline(always)]
+    pub(crate) fn probe_at(&self, i: u32, step: f64) -> (f64, f64) {
+        let t = i as f64 * step - 0.5;
+        (self.u + t * self.major[0], self.v + t * self.major[1])
+    }
+
     /// A placeholder (overwritten before use).
     pub const EMPTY: Setup = Setup {
         plan: Plan::MAGNIFY,
@@ -79,16 +87,8 @@ pub(crate) fn anisotropic<P: Pixel, S: TexelSink, F: Filters>(
     let inv = 1.0 / n as f32;
     let mut acc = [0.0f32; 4];
     for i in 1..=n {
-        let t = i as f64 * step - 0.5;
-        let p = probe(
-            c,
-            f,
-            &st.plan,
-            u + t * st.major[0],
-            v + t * st.major[1],
-            a,
-            sink,
-        );
+        let (pu, pv) = st.probe_at(i, step);
+        let p = probe(c, f, &st.plan, pu, pv, a, sink);
         for k in 0..4 {
             acc[k] += p[k] * inv;
         }

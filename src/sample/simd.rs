@@ -43,7 +43,7 @@ use std::sync::OnceLock;
 use super::aniso::Setup;
 use super::bilinear::Lin;
 use super::fetch::{Addressing, Chain, Lut8, Pixel};
-use super::footprint::{LOG2_BITS, LOG2_TABLE, Lod, UNBOUNDED_TEXELS};
+use super::footprint::{LOG2_BITS, LOG2_TABLE, Lod, Plan, UNBOUNDED_TEXELS};
 use super::trace::NoTrace;
 use super::trilinear::{self, MIP_LINEAR, MIP_NEAREST};
 use super::{Query, SamplerOptions, aniso};
@@ -171,16 +171,6 @@ fn epi64x2(a: &[i64; 16]) -> [__m512i; 2] {
             _mm512_loadu_epi64(a.as_ptr().add(8)),
         ]
     }
-}
-
-/// The lanes of a register.
-#[inline]
-#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
-fn f64s(x: __m512d) -> [f64; 8] {
-    let mut a = [0f64; 8];
-    // SAFETY: one unaligned 64-byte store into the 64-byte array.
-    unsafe { _mm512_storeu_pd(a.as_mut_ptr(), x) };
-    a
 }
 
 #[inline]
@@ -653,22 +643,118 @@ fn plans<const MIP: u8>(
             _mm512_set1_pd(o.lod_bias as f64),
         );
         let lambda = _mm512_cvtpd_ps(clamp_pd(base, o.lod_min as f64, o.lod_max as f64));
-        let zero = _mm256_setzero_ps();
-        // λ ≤ 0 (or NaN): magnification, level 0 alone.
-        let minify = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(lambda, zero);
-        let q = _mm256_set1_epi32(lod.q as i32);
-        let d = _mm256_min_ps(_mm256_max_ps(lambda, zero), _mm256_set1_ps(lod.q as f32));
-        let h = _mm256_min_epi32(_mm256_cvttps_epi32(d), q);
-        let lo = _mm256_min_epi32(_mm256_add_epi32(h, _mm256_set1_epi32(1)), q);
+        let (h, lo, delta) = levels::<MIP_LINEAR>(lambda, lod.q);
+        (h, lo, delta, ok)
+    }
+}
+
+/// `Plan::at(λ, q, mip)` per lane, for mip mode `MIP` nearest or linear:
+/// levels `hi` and `lo` and the blend δ; λ ≤ 0 (or NaN) is
+/// magnification, level 0 alone.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn levels<const MIP: u8>(lambda: __m256, q: usize) -> (__m512i, __m512i, __m256) {
+    let zero = _mm256_setzero_ps();
+    let minify = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(lambda, zero);
+    let qi = _mm256_set1_epi32(q as i32);
+    // d' = clamp(λ, 0, q).
+    let d = _mm256_min_ps(_mm256_max_ps(lambda, zero), _mm256_set1_ps(q as f32));
+    if MIP == MIP_NEAREST {
+        // `mip_nearest`: ceil(d' + 0.5) − 1 as trunc(x) − [x integral].
+        let x = _mm256_add_ps(d, _mm256_set1_ps(0.5));
+        let t = _mm256_cvttps_epi32(x);
+        let whole = _mm256_cmp_ps_mask::<_CMP_EQ_OQ>(_mm256_cvtepi32_ps(t), x);
+        let t = _mm256_mask_sub_epi32(t, whole, t, _mm256_set1_epi32(1));
+        let h = _mm256_min_epi32(_mm256_max_epi32(t, _mm256_setzero_si256()), qi);
+        let h = _mm512_cvtepi32_epi64(_mm256_maskz_mov_epi32(minify, h));
+        (h, h, zero)
+    } else {
+        // `mip_linear`.
+        let h = _mm256_min_epi32(_mm256_cvttps_epi32(d), qi);
+        let lo = _mm256_min_epi32(_mm256_add_epi32(h, _mm256_set1_epi32(1)), qi);
         let delta = _mm256_maskz_mov_ps(minify, _mm256_sub_ps(d, _mm256_cvtepi32_ps(h)));
-        let h = _mm256_maskz_mov_epi32(minify, h);
-        let lo = _mm256_maskz_mov_epi32(minify, lo);
         (
-            _mm512_cvtepi32_epi64(h),
-            _mm512_cvtepi32_epi64(lo),
+            _mm512_cvtepi32_epi64(_mm256_maskz_mov_epi32(minify, h)),
+            _mm512_cvtepi32_epi64(_mm256_maskz_mov_epi32(minify, lo)),
             delta,
-            ok,
         )
+    }
+}
+
+/// `aniso::setup` of 8 queries into `out`: the footprint (`footprint_f64`)
+/// lane-wise; lanes with a non-finite derivative or a ρ the table `log2`
+/// does not cover take the portable setup.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn setups<const MIP: u8>(lod: &Lod, o: &SamplerOptions, q8: &[Query; 8], out: &mut [Setup]) {
+    let f = fields(q8);
+    let max = _mm512_set1_pd(f64::MAX);
+    let mut fin = 0xFFu8;
+    for x in &f[2..6] {
+        fin &= _mm512_cmp_pd_mask::<_CMP_LE_OQ>(_mm512_abs_pd(*x), max);
+    }
+    let (wf, hf) = (_mm512_set1_pd(lod.wf), _mm512_set1_pd(lod.hf));
+    let (ax, ay) = (_mm512_mul_pd(f[2], wf), _mm512_mul_pd(f[3], hf));
+    let (bx, by) = (_mm512_mul_pd(f[4], wf), _mm512_mul_pd(f[5], hf));
+    let rx2 = _mm512_add_pd(_mm512_mul_pd(ax, ax), _mm512_mul_pd(ay, ay));
+    let ry2 = _mm512_add_pd(_mm512_mul_pd(bx, bx), _mm512_mul_pd(by, by));
+    let (rho_x, rho_y) = (_mm512_sqrt_pd(rx2), _mm512_sqrt_pd(ry2));
+    let ge = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(rx2, ry2);
+    let max2 = _mm512_mask_blend_pd(ge, ry2, rx2);
+    let rho_max = _mm512_mask_blend_pd(ge, rho_y, rho_x);
+    let rho_min = _mm512_mask_blend_pd(ge, rho_x, rho_y);
+    let major_u = _mm512_mask_blend_pd(ge, f[4], f[2]);
+    let major_v = _mm512_mask_blend_pd(ge, f[5], f[3]);
+    // η = min(ρmax/ρmin, n); n when ρmin = 0; 1 when ρmax = 0.
+    let n = _mm512_set1_pd(o.max_aniso.clamp(1, 16) as f64);
+    let zero = _mm512_setzero_pd();
+    let eta = _mm512_min_pd(_mm512_div_pd(rho_max, rho_min), n);
+    let eta = _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(rho_min, zero), eta, n);
+    let eta = _mm512_mask_blend_pd(
+        _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(rho_max, zero),
+        eta,
+        _mm512_set1_pd(1.0),
+    );
+    let (l2, ok) = log2(_mm512_div_pd(max2, _mm512_mul_pd(eta, eta)));
+    let base = _mm512_add_pd(
+        _mm512_mul_pd(_mm512_set1_pd(0.5), l2),
+        _mm512_set1_pd(o.lod_bias as f64),
+    );
+    let lambda = _mm512_cvtpd_ps(clamp_pd(base, o.lod_min as f64, o.lod_max as f64));
+    let minify = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(lambda, _mm256_setzero_ps());
+    let (hi, lo, delta) = levels::<MIP>(lambda, lod.q);
+    const CEIL: i32 = _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC;
+    let probes = _mm512_cvttpd_epi32(_mm512_roundscale_pd::<CEIL>(eta));
+    let (mut hs, mut ls, mut ds, mut ns) = ([0i64; 8], [0i64; 8], [0f32; 8], [0i32; 8]);
+    let (mut mu, mut mv) = ([0f64; 8], [0f64; 8]);
+    // SAFETY: unaligned stores of whole registers into arrays of their size.
+    unsafe {
+        _mm512_storeu_epi64(hs.as_mut_ptr(), hi);
+        _mm512_storeu_epi64(ls.as_mut_ptr(), lo);
+        _mm256_storeu_ps(ds.as_mut_ptr(), delta);
+        _mm256_storeu_si256(ns.as_mut_ptr().cast(), probes);
+        _mm512_storeu_pd(mu.as_mut_ptr(), major_u);
+        _mm512_storeu_pd(mv.as_mut_ptr(), major_v);
+    }
+    let exact = fin & ok;
+    for (i, (q, s)) in q8.iter().zip(out.iter_mut()).enumerate() {
+        *s = if exact >> i & 1 == 1 {
+            let (u, v) = lod.reduce(q);
+            Setup {
+                plan: Plan {
+                    magnify: minify >> i & 1 == 0,
+                    hi: hs[i] as usize,
+                    lo: ls[i] as usize,
+                    delta: ds[i],
+                },
+                probes: ns[i] as u32,
+                u,
+                v,
+                major: [mu[i], mv[i]],
+            }
+        } else {
+            aniso::setup::<Lin, MIP>(lod, o, q)
+        };
     }
 }
 
@@ -845,7 +931,10 @@ fn portable<P: Pixel, const MIP: u8>(
 
 /// Footprint-assembly lookups (`Lin` filters, mip mode `MIP`) of
 /// `queries` into `out`: `aniso::setup` per query as the portable code
-/// does it, then the probes 8 at a time.
+/// does it, then the probes of a chunk of queries packed 8 to a block
+/// (probes of different queries share a block, so lanes are not wasted
+/// on queries with few probes), staged before they are read (see
+/// [`Staged`]), and finally each query's probes summed in probe order.
 ///
 /// # Safety
 /// As [`isotropic`].
@@ -859,102 +948,148 @@ pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
     queries: &[Query],
     out: &mut [[f32; 4]],
 ) {
+    // At most 16 probes per query.
+    const MAX_PROBES: usize = 16 * super::BLOCK;
+    const MAX_BLOCKS: usize = MAX_PROBES / 8;
     let ls = Levels::new(table);
+    let mut staged = [Staged::EMPTY; MAX_BLOCKS];
+    let mut probes = Probes {
+        u: [0.0; MAX_PROBES],
+        v: [0.0; MAX_PROBES],
+        hi: [0; MAX_PROBES],
+        lo: [0; MAX_PROBES],
+        delta: [0.0; MAX_PROBES],
+    };
+    let mut colour = [[0f32; 4]; MAX_PROBES];
     for (qs, os) in queries
         .chunks(super::BLOCK)
         .zip(out.chunks_mut(super::BLOCK))
     {
         let mut st = [Setup::EMPTY; super::BLOCK];
-        for (s, q) in st.iter_mut().zip(qs) {
+        let mut q8s = qs.chunks_exact(8);
+        for (q8, s) in (&mut q8s).zip(st.chunks_exact_mut(8)) {
+            setups::<MIP>(lod, opts, q8.try_into().expect("8 queries"), s);
+        }
+        let done = qs.len() - q8s.remainder().len();
+        for (s, q) in st[done..].iter_mut().zip(q8s.remainder()) {
             *s = aniso::setup::<Lin, MIP>(lod, opts, q);
         }
-        for (s, o) in st.iter().zip(os.iter_mut()) {
-            *o = probes(c, &ls, a, s);
+        let mut np = 0;
+        for s in &st[..qs.len()] {
+            let n = s.probes.max(1);
+            let step = 1.0 / (n as f64 + 1.0);
+            for i in 1..=n {
+                let (u, v) = if n == 1 {
+                    (s.u, s.v)
+                } else {
+                    s.probe_at(i, step)
+                };
+                probes.u[np] = u;
+                probes.v[np] = v;
+                probes.hi[np] = s.plan.hi as i64;
+                probes.lo[np] = s.plan.lo as i64;
+                probes.delta[np] = s.plan.delta;
+                np += 1;
+            }
+        }
+        let nb = np.div_ceil(8);
+        for (k, s) in staged[..nb].iter_mut().enumerate() {
+            let live = if 8 * k + 8 <= np {
+                0xFF
+            } else {
+                ((1u16 << (np - 8 * k)) - 1) as u8
+            };
+            stage_probes::<P, MIP, MAX_PROBES>(&ls, &probes, 8 * k, live, s);
+        }
+        for (s, col) in staged[..nb].iter().zip(colour.chunks_exact_mut(8)) {
+            for h in 0..2 {
+                if s.fast >> (4 * h) & 0xF == 0 {
+                    continue;
+                }
+                let r = colours::<P, MIP>(c, s, h);
+                // SAFETY: one unaligned 64-byte store into 4 RGBA values.
+                unsafe { _mm512_storeu_ps(col[4 * h..].as_mut_ptr().cast(), r) };
+            }
+        }
+        let mut k = 0;
+        for (s, o) in st[..qs.len()].iter().zip(os.iter_mut()) {
+            let n = s.probes.max(1) as usize;
+            // Probes the first pass left out, the portable way.
+            for i in k..k + n {
+                if staged[i / 8].fast >> (i % 8) & 1 == 0 {
+                    colour[i] = trilinear::probe(
+                        c,
+                        Lin,
+                        &s.plan,
+                        probes.u[i],
+                        probes.v[i],
+                        a,
+                        &mut NoTrace,
+                    );
+                }
+            }
+            *o = if n == 1 {
+                colour[k]
+            } else {
+                let inv = 1.0 / n as f32;
+                let mut acc = [0f32; 4];
+                for p in &colour[k..k + n] {
+                    for c in 0..4 {
+                        acc[c] += p[c] * inv;
+                    }
+                }
+                acc
+            };
+            k += n;
         }
     }
 }
 
-/// The probes of one footprint-assembly lookup, as `aniso::anisotropic`:
-/// 8 probe positions per step, summed in probe order.
+/// The probes of a chunk of footprint-assembly lookups, one entry per
+/// probe: position, levels and blend.
+struct Probes<const N: usize> {
+    u: [f64; N],
+    v: [f64; N],
+    hi: [i64; N],
+    lo: [i64; N],
+    delta: [f32; N],
+}
+
+/// Stages probes `first … first + 7` (the lanes in `live`) into `s`.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
-fn probes<P: Pixel>(c: &Chain<P>, ls: &Levels, a: &Addressing, st: &Setup) -> [f32; 4] {
-    let (n, plan) = (st.probes.max(1), &st.plan);
-    let (hi, lo) = (
-        _mm512_set1_epi64(plan.hi as i64),
-        _mm512_set1_epi64(plan.lo as i64),
-    );
-    let two = plan.delta > 0.0 && plan.lo != plan.hi;
-    let (delta, omd) = (_mm512_set1_ps(plan.delta), _mm512_set1_ps(1.0 - plan.delta));
-    let step = _mm512_set1_pd(1.0 / (n as f64 + 1.0));
-    let inv = 1.0 / n as f32;
-    let mut acc = [0f32; 4];
-    let mut first = 1;
-    while first <= n {
-        let lanes = (n + 1 - first).min(8);
-        let (pu, pv) = if n == 1 {
-            // One probe, at the centre itself.
-            (_mm512_set1_pd(st.u), _mm512_set1_pd(st.v))
-        } else {
-            let i = _mm512_add_pd(
-                _mm512_set_pd(7.0, 6.0, 5.0, 4.0, 3.0, 2.0, 1.0, 0.0),
-                _mm512_set1_pd(first as f64),
-            );
-            let t = _mm512_sub_pd(_mm512_mul_pd(i, step), _mm512_set1_pd(0.5));
-            let (u, v) = (_mm512_set1_pd(st.u), _mm512_set1_pd(st.v));
-            (
-                _mm512_add_pd(u, _mm512_mul_pd(t, _mm512_set1_pd(st.major[0]))),
-                _mm512_add_pd(v, _mm512_mul_pd(t, _mm512_set1_pd(st.major[1]))),
-            )
-        };
-        let live = ((1u16 << lanes) - 1) as u8;
-        let bh = blocks::<P>(ls, hi, pu, pv);
-        let bl = if two {
-            Some(blocks::<P>(ls, lo, pu, pv))
-        } else {
-            None
-        };
-        let fast = live & bh.inside & bl.as_ref().map_or(0xFF, |b| b.inside);
-        let (top, bot) = addresses(&bh, fast);
-        // Not `Option::map`: a closure would not get the target features.
-        #[allow(clippy::manual_map)]
-        let second = match &bl {
-            Some(b) => Some(addresses(b, fast)),
-            None => None,
-        };
-        let mut p = [[0f32; 4]; 8];
-        for h in 0..lanes.div_ceil(4) as usize {
-            // SAFETY: lanes in `fast` are inside their level, the others
-            // read `ZEROS` (`addresses`).
-            let mut r = bilerp(
-                unsafe { group::<P>(&c.lut, &top, &bot, h) },
-                bh.al,
-                bh.be,
-                h,
-            );
-            if let (Some(b), Some((t2, b2))) = (&bl, &second) {
-                // SAFETY: as above.
-                let r2 = bilerp(unsafe { group::<P>(&c.lut, t2, b2, h) }, b.al, b.be, h);
-                r = lerp16(r, r2, omd, delta);
-            }
-            // SAFETY: one unaligned 64-byte store into 4 RGBA values.
-            unsafe { _mm512_storeu_ps(p[4 * h..].as_mut_ptr().cast(), r) };
+fn stage_probes<P: Pixel, const MIP: u8, const N: usize>(
+    ls: &Levels,
+    p: &Probes<N>,
+    first: usize,
+    live: u8,
+    s: &mut Staged,
+) {
+    let end = first + 8;
+    // SAFETY: 64- and 32-byte loads of 8 entries inside the arrays (the
+    // chunk holds whole blocks of 8).
+    let (u, v, hi, lo, delta) = unsafe {
+        (
+            _mm512_loadu_pd(p.u[first..end].as_ptr()),
+            _mm512_loadu_pd(p.v[first..end].as_ptr()),
+            _mm512_loadu_epi64(p.hi[first..end].as_ptr()),
+            _mm512_loadu_epi64(p.lo[first..end].as_ptr()),
+            _mm256_loadu_ps(p.delta[first..end].as_ptr()),
+        )
+    };
+    let bh = blocks::<P>(ls, hi, u, v);
+    let fast = live & bh.inside;
+    if MIP == MIP_LINEAR {
+        // As `isotropic`: lanes that blend a second level.
+        let two = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(delta, _mm256_setzero_ps())
+            & _mm512_cmpneq_epi64_mask(lo, hi)
+            & fast;
+        if two != 0 {
+            let bl = blocks::<P>(ls, lo, u, v);
+            let fast = fast & (!two | bl.inside);
+            stage(s, &bh, Some(&bl), delta, fast, two & fast);
+            return;
         }
-        if fast != live {
-            let (pus, pvs) = (f64s(pu), f64s(pv));
-            for i in (0..lanes as usize).filter(|&i| fast >> i & 1 == 0) {
-                p[i] = trilinear::probe(c, Lin, plan, pus[i], pvs[i], a, &mut NoTrace);
-            }
-        }
-        if n == 1 {
-            return p[0];
-        }
-        for p in &p[..lanes as usize] {
-            for k in 0..4 {
-                acc[k] += p[k] * inv;
-            }
-        }
-        first += 8;
     }
-    acc
+    stage(s, &bh, None, delta, fast, 0);
 }
