@@ -463,12 +463,9 @@ fn lerp16(x: __m512, y: __m512, omt: __m512, t: __m512) -> __m512 {
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn bilerp(d: [__m512; 4], al8: __m256, be8: __m256, h: usize) -> __m512 {
-    let one = _mm256_set1_ps(1.0);
+    let one = _mm512_set1_ps(1.0);
     let (al, be) = (spread(al8, h), spread(be8, h));
-    let (oma, omb) = (
-        spread(_mm256_sub_ps(one, al8), h),
-        spread(_mm256_sub_ps(one, be8), h),
-    );
+    let (oma, omb) = (_mm512_sub_ps(one, al), _mm512_sub_ps(one, be));
     lerp16(
         lerp16(d[0], d[1], oma, al),
         lerp16(d[2], d[3], oma, al),
