@@ -8,9 +8,16 @@
 //! - `grazing`: a 256×256 perspective ground plane 10° below the horizon,
 //!   anisotropy up to 16 (what aniso and EWA are for).
 //!
-//! Groups: `1t/rgba8` (one thread, no tracing), `1t/rgba8/traced` (a
-//! counting sink, to show what tracing costs and that `NoTrace` is free),
-//! `1t/rgbaf32`, `mt/rgba8` (`sample_batch` on all threads).
+//! Groups:
+//! - `1t/rgba8`, `1t/rgbaf32`: one thread, no tracing (the AVX-512 path
+//!   where the CPU has it);
+//! - `1t/rgba8/portable`: the portable code (`Sampler::set_simd(false)`),
+//!   no sink (`NoTrace`);
+//! - `1t/rgba8/portable/empty-sink`: the same code through a sink whose
+//!   `texel` does nothing: equal to the line above when the no-op sink
+//!   compiles away;
+//! - `1t/rgba8/traced`: a counting sink (what tracing costs);
+//! - `mt/rgba8`: `sample_batch` on all threads.
 //!
 //! Short run: `cargo bench --bench sample -- --warm-up-time 1 --measurement-time 2`.
 
@@ -19,11 +26,20 @@ use std::sync::Arc;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use parvo::sample::plane::GroundPlane;
-use parvo::sample::{LinearChain, Query, Sampler, SamplerOptions, TexelCounter};
+use parvo::sample::{LinearChain, Query, Sampler, SamplerOptions, TexelCounter, TexelSink};
 use parvo::texel::{ChannelType, ColorSpace, Format};
 use parvo::{MipOptions, builtin, mip};
 
 const SIZE: u32 = 2048;
+
+/// A sink that is told every texel and does nothing with it (a tracing
+/// sink as far as the sampler knows: `TRACES` keeps its default).
+struct EmptySink;
+
+impl TexelSink for EmptySink {
+    #[inline(always)]
+    fn texel(&mut self, _level: u32, _x: u32, _y: u32) {}
+}
 
 fn incache() -> Vec<Query> {
     let n = 200;
@@ -88,25 +104,32 @@ fn bench(c: &mut Criterion) {
     let (qi, qg) = (incache(), grazing());
     for (group, chain, mode) in [
         ("1t/rgba8", &c8, 0),
+        ("1t/rgba8/portable", &c8, 3),
+        ("1t/rgba8/portable/empty-sink", &c8, 4),
         ("1t/rgba8/traced", &c8, 1),
         ("1t/rgbaf32", &c32, 0),
         ("mt/rgba8", &c8, 2),
     ] {
         let mut g = c.benchmark_group(group);
         for (name, opts, in_cache) in cases() {
-            let s = Sampler::from_linear(chain.clone(), opts).unwrap();
+            let mut s = Sampler::from_linear(chain.clone(), opts).unwrap();
+            s.set_simd(mode != 3 && mode != 4);
             let qs = if in_cache { &qi } else { &qg };
             let mut out = vec![[0f32; 4]; qs.len()];
             g.throughput(Throughput::Elements(qs.len() as u64));
             g.bench_function(name, |b| match mode {
-                0 => b.iter(|| s.sample_slice(black_box(qs), &mut out).unwrap()),
                 1 => b.iter(|| {
                     let mut sink = TexelCounter::default();
                     s.sample_slice_traced(black_box(qs), &mut out, &mut sink)
                         .unwrap();
                     black_box(sink.count)
                 }),
-                _ => b.iter(|| s.sample_batch(black_box(qs), &mut out).unwrap()),
+                4 => b.iter(|| {
+                    s.sample_slice_traced(black_box(qs), &mut out, &mut EmptySink)
+                        .unwrap()
+                }),
+                2 => b.iter(|| s.sample_batch(black_box(qs), &mut out).unwrap()),
+                _ => b.iter(|| s.sample_slice(black_box(qs), &mut out).unwrap()),
             });
         }
         g.finish();

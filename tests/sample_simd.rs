@@ -126,6 +126,19 @@ fn simd_lookups_equal_the_portable_lookups_bit_for_bit() {
                         qs[i]
                     );
                 }
+                // With the SIMD path forbidden, the portable one.
+                let mut portable = s.clone();
+                portable.set_simd(false);
+                assert!(!portable.uses_simd());
+                let mut off = vec![[0f32; 4]; qs.len()];
+                portable.sample_slice(&qs, &mut off).unwrap();
+                assert!(
+                    off.iter()
+                        .zip(&plain)
+                        .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits))
+                );
+                portable.set_simd(true);
+                assert_eq!(portable.uses_simd(), s.uses_simd());
                 // One query at a time takes the same path as a slice.
                 for (q, want) in qs.iter().zip(&plain).step_by(37) {
                     assert_eq!(s.sample(q).map(f32::to_bits), want.map(f32::to_bits));

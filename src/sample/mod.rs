@@ -579,10 +579,7 @@ impl Sampler {
         let (wf, hf) = chain.size0();
         let lod = Lod::new(&options, wf, hf, chain.len());
         #[cfg(target_arch = "x86_64")]
-        let simd = match &chain.store {
-            Store::Rgba8(c) => simd::LevelTable::new(c),
-            Store::F32(c) => simd::LevelTable::new(c),
-        };
+        let simd = simd_table(&chain);
         Ok(Sampler {
             chain,
             options,
@@ -617,6 +614,24 @@ impl Sampler {
         }
         #[cfg(not(target_arch = "x86_64"))]
         false
+    }
+
+    /// Allows (`true`, the default) or forbids the AVX-512 path of
+    /// [`uses_simd`](Self::uses_simd) for this sampler. The results are
+    /// the same bit for bit; forbidding it times the portable code, or
+    /// rules the SIMD code out while debugging. Allowing it does nothing
+    /// where the CPU, `PARVO_NO_AVX` or the texture format rule it out.
+    pub fn set_simd(&mut self, allowed: bool) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            self.simd = if allowed {
+                simd_table(&self.chain)
+            } else {
+                None
+            };
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = allowed;
     }
 
     /// The options.
@@ -774,6 +789,15 @@ impl Sampler {
                 }
             }
         }
+    }
+}
+
+/// The AVX-512 level table of `chain`, if that path can run on it.
+#[cfg(target_arch = "x86_64")]
+fn simd_table(chain: &LinearChain) -> Option<simd::LevelTable> {
+    match &chain.store {
+        Store::Rgba8(c) => simd::LevelTable::new(c),
+        Store::F32(c) => simd::LevelTable::new(c),
     }
 }
 
