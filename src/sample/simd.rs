@@ -204,13 +204,14 @@ fn blocks<P: Pixel>(ls: &Levels, lvl: __m512i, u: __m512d, v: __m512d) -> Blocks
     let half = _mm512_set1_pd(0.5);
     let x = _mm512_sub_pd(_mm512_mul_pd(u, look_pd(&ls.wf, lvl)), half);
     let y = _mm512_sub_pd(_mm512_mul_pd(v, look_pd(&ls.hf, lvl)), half);
+    // floor(x) as an integer in one conversion rounding down. NaN, ±∞
+    // and values beyond i64 convert to i64::MIN: huge as unsigned, so
+    // outside every level, as `floor_fast` makes them. For lanes inside a
+    // level the integer converts back to floor(x) exactly.
     const FLOOR: i32 = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
-    let fx = _mm512_roundscale_pd::<FLOOR>(x);
-    let fy = _mm512_roundscale_pd::<FLOOR>(y);
-    // NaN, ±∞ and values beyond i64 convert to i64::MIN: huge as unsigned,
-    // so outside every level, as `floor_fast` makes them.
-    let i0 = _mm512_cvttpd_epi64(fx);
-    let j0 = _mm512_cvttpd_epi64(fy);
+    let i0 = _mm512_cvt_roundpd_epi64::<FLOOR>(x);
+    let j0 = _mm512_cvt_roundpd_epi64::<FLOOR>(y);
+    let (fx, fy) = (_mm512_cvtepi64_pd(i0), _mm512_cvtepi64_pd(j0));
     let inside = _mm512_cmplt_epu64_mask(i0, look_epi64(&ls.wm1, lvl))
         & _mm512_cmplt_epu64_mask(j0, look_epi64(&ls.hm1, lvl));
     // Lanes inside the level have 0 ≤ i0, j0 and w below 2^32, so a
