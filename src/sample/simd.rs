@@ -345,32 +345,32 @@ unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
             *p = _mm512_mask_blend_epi8(ALPHA, *p, a);
         }
     }
+    if lut.alpha_linear && !lut.alpha_same {
+        // Linear alpha, `texel::decode_u8`: each texel's alpha code (its
+        // top byte) as f32 times 1/255, in the texel's own 32 bits. Byte k
+        // of that f32 goes to the alpha byte of plane k: shifted up by
+        // 3 − k bytes, then blended (no shuffle-port work).
+        let a = _mm512_castps_si512(_mm512_mul_ps(
+            _mm512_cvtepi32_ps(_mm512_srli_epi32::<24>(codes)),
+            _mm512_set1_ps(1.0 / 255.0),
+        ));
+        p[0] = _mm512_mask_blend_epi8(ALPHA, p[0], _mm512_slli_epi32::<24>(a));
+        p[1] = _mm512_mask_blend_epi8(ALPHA, p[1], _mm512_slli_epi32::<16>(a));
+        p[2] = _mm512_mask_blend_epi8(ALPHA, p[2], _mm512_slli_epi32::<8>(a));
+        p[3] = _mm512_mask_blend_epi8(ALPHA, p[3], a);
+    }
     // Within each 128-bit group (one lane's 16 codes): bytes 0-1 and 2-3
     // of each f32, then the f32s of codes 0-3, 4-7, 8-11 and 12-15.
     let a = _mm512_unpacklo_epi8(p[0], p[1]);
     let b = _mm512_unpackhi_epi8(p[0], p[1]);
     let c = _mm512_unpacklo_epi8(p[2], p[3]);
     let d = _mm512_unpackhi_epi8(p[2], p[3]);
-    let d = [
+    [
         _mm512_castsi512_ps(_mm512_unpacklo_epi16(a, c)),
         _mm512_castsi512_ps(_mm512_unpackhi_epi16(a, c)),
         _mm512_castsi512_ps(_mm512_unpacklo_epi16(b, d)),
         _mm512_castsi512_ps(_mm512_unpackhi_epi16(b, d)),
-    ];
-    if lut.alpha_linear && !lut.alpha_same {
-        // Alphas of corners 00, 10, 01, 11; float 3 of each group of
-        // corner k takes alpha k.
-        const ALPHA16: u16 = 0x8888;
-        let al = widen(codes, [dw(3), dw(7), dw(11), dw(15)]);
-        [
-            _mm512_mask_shuffle_ps::<0b00_00_00_00>(d[0], ALPHA16, al, al),
-            _mm512_mask_shuffle_ps::<0b01_01_01_01>(d[1], ALPHA16, al, al),
-            _mm512_mask_shuffle_ps::<0b10_10_10_10>(d[2], ALPHA16, al, al),
-            _mm512_mask_shuffle_ps::<0b11_11_11_11>(d[3], ALPHA16, al, al),
-        ]
-    } else {
-        d
-    }
+    ]
 }
 
 /// Two 32-byte rows in one register.
