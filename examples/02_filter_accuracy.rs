@@ -63,6 +63,17 @@ fn main() -> Result<(), parvo::Error> {
     ];
     let textures = ["builtin:checker:256", "builtin:zoneplate:256"];
     let mut table = vec![vec![0.0f64; textures.len()]; filters.len()];
+    // Per footprint size: bin b holds ρmax in (2^(b−1), 2^b] (bin 0: ≤ 1).
+    let t = SamplerOptions::trilinear();
+    let bins: Vec<usize> = queries
+        .iter()
+        .map(|q| {
+            let fp = footprint(q, 256, 256, &t);
+            fp.rho_x.max(fp.rho_y).log2().ceil().clamp(0.0, 5.0) as usize
+        })
+        .collect();
+    let binned = [2, 6, 7]; // trilinear, aniso16, ewa
+    let mut by_bin = vec![vec![[0.0f64; 6]; binned.len()]; textures.len()];
     for (t, name) in textures.iter().enumerate() {
         let chain = mip::build(builtin::load(name)?, &MipOptions::default())?;
         let reference = Sampler::new(&chain, SamplerOptions::supersample(64))?;
@@ -73,6 +84,15 @@ fn main() -> Result<(), parvo::Error> {
             let mut got = vec![[0f32; 4]; queries.len()];
             s.sample_batch(&queries, &mut got)?;
             table[f][t] = rmse(&want, &got);
+            if let Some(k) = binned.iter().position(|&b| b == f) {
+                for (b, row) in by_bin[t][k].iter_mut().enumerate() {
+                    let (w, g): (Vec<_>, Vec<_>) = (0..queries.len())
+                        .filter(|&i| bins[i] == b)
+                        .map(|i| (want[i], got[i]))
+                        .unzip();
+                    *row = rmse(&w, &g);
+                }
+            }
         }
     }
     println!(
@@ -83,6 +103,21 @@ fn main() -> Result<(), parvo::Error> {
     println!("|---|---:|---:|");
     for (f, o) in filters.iter().enumerate() {
         println!("| {} | {:.5} | {:.5} |", o.name(), table[f][0], table[f][1]);
+    }
+    let counts: Vec<usize> = (0..6)
+        .map(|b| bins.iter().filter(|&&x| x == b).count())
+        .collect();
+    println!("\nThe same RMSE by footprint length ρmax (level-0 texels):\n");
+    println!(
+        "| texture | filter | ≤ 1 ({}) | 1–2 ({}) | 2–4 ({}) | 4–8 ({}) | 8–16 ({}) | 16–32 ({}) |",
+        counts[0], counts[1], counts[2], counts[3], counts[4], counts[5]
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|");
+    for (t, name) in textures.iter().enumerate() {
+        for (k, &f) in binned.iter().enumerate() {
+            let cells: Vec<String> = by_bin[t][k].iter().map(|e| format!("{e:.4}")).collect();
+            println!("| {name} | {} | {} |", filters[f].name(), cells.join(" | "));
+        }
     }
     Ok(())
 }
