@@ -12,21 +12,29 @@
 //! extreme queries. Only the way the work is spread over registers
 //! differs:
 //!
-//! - **Per block of 8 queries (or 8 probes)**, one lane each: the query
-//!   fields transposed from the array of queries, the footprint, level
-//!   choice, blend weight and address of the 2×2 block on each level, and
-//!   whether that block lies inside its level.
-//! - **Per 4 lanes**, one 512-bit register per corner of the block (lane
-//!   `j` in 128-bit group `j`, RGBA `f32`): a packed RGBA8 block is two
-//!   8-byte loads per lane, and the 64 codes of 4 lanes are decoded at
-//!   once — `vpermi2b` looks each code up in the four byte planes of the
-//!   decode table and unpacking interleaves the planes back into `f32`s;
-//!   linear channels are converted and scaled instead. An `f32` block is
-//!   two 32-byte loads per lane. The bilinear blend and the level blend
-//!   then run on 4 lanes per instruction and store 4 results at once.
+//! - **First pass, per block of 8 queries (or 8 probes)**, one lane
+//!   each: the query fields transposed from the array of queries, the
+//!   footprint, level choice, blend weight and address of the 2×2 block on
+//!   each level, and whether that block lies inside its level, staged in
+//!   memory for a chunk of blocks ([`Staged`]). Footprint assembly first
+//!   sets up 8 queries at a time, then lays the probes of a chunk of
+//!   queries end to end, so probes of different queries share a block.
+//! - **Second pass, per 4 lanes**, one 512-bit register per corner of the
+//!   block (lane `j` in 128-bit group `j`, RGBA `f32`): a packed RGBA8
+//!   block is two 8-byte loads per lane, and the 64 codes of 4 lanes are
+//!   decoded at once — `vpermi2b` looks each code up in the four byte
+//!   planes of the decode table and unpacking interleaves the planes back
+//!   into `f32`s; linear channels are converted and scaled instead. An
+//!   `f32` block is two 32-byte loads per lane. The bilinear blend and the
+//!   level blend then run on 4 lanes per instruction and store 4 results
+//!   at once. Footprint assembly then sums each query's probes in order.
 //!
-//! No gathers: on the machines measured they cost about two cycles per
-//! element, more than the loads and table look-ups above.
+//! Two passes rather than one loop from query to colour: each loop's
+//! iterations are short and independent, so the core overlaps them.
+//!
+//! No gathers for texels: on the machines measured they cost about two
+//! cycles per element, more than the loads and table look-ups above (the
+//! table `log2` of the trilinear level does gather).
 //!
 //! A lane whose block is not inside its level (NaN or huge coordinates,
 //! edge crossings, a λ the table `log2` does not cover) reads a block of
