@@ -552,15 +552,33 @@ const FIELD_HIGH: [u16; 6] = {
     t
 };
 
+/// ρx² and ρy² per lane: the squared lengths of the derivative vectors
+/// in level-0 texels, as `square_len` in `footprint`.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn square_lens(lod: &Lod, f: &[__m512d; 6]) -> (__m512d, __m512d) {
+    let (wf, hf) = (_mm512_set1_pd(lod.wf), _mm512_set1_pd(lod.hf));
+    let (ax, ay) = (_mm512_mul_pd(f[2], wf), _mm512_mul_pd(f[3], hf));
+    let (bx, by) = (_mm512_mul_pd(f[4], wf), _mm512_mul_pd(f[5], hf));
+    (
+        _mm512_add_pd(_mm512_mul_pd(ax, ax), _mm512_mul_pd(ay, ay)),
+        _mm512_add_pd(_mm512_mul_pd(bx, bx), _mm512_mul_pd(by, by)),
+    )
+}
+
+/// Lanes that blend a second level: δ > 0 and a level `lo` other than
+/// `hi` (as `trilinear::probe`).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn blends_two(delta: __m256, hi: __m512i, lo: __m512i) -> u8 {
+    _mm256_cmp_ps_mask::<_CMP_GT_OQ>(delta, _mm256_setzero_ps()) & _mm512_cmpneq_epi64_mask(lo, hi)
+}
+
 /// ρmax² per lane, as `Lod::rho2`.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn rho2(lod: &Lod, f: &[__m512d; 6]) -> __m512d {
-    let (wf, hf) = (_mm512_set1_pd(lod.wf), _mm512_set1_pd(lod.hf));
-    let (ax, ay) = (_mm512_mul_pd(f[2], wf), _mm512_mul_pd(f[3], hf));
-    let (bx, by) = (_mm512_mul_pd(f[4], wf), _mm512_mul_pd(f[5], hf));
-    let rx2 = _mm512_add_pd(_mm512_mul_pd(ax, ax), _mm512_mul_pd(ay, ay));
-    let ry2 = _mm512_add_pd(_mm512_mul_pd(bx, bx), _mm512_mul_pd(by, by));
+    let (rx2, ry2) = square_lens(lod, f);
     let s = _mm512_add_pd(rx2, ry2);
     let bad = _mm512_cmp_pd_mask::<_CMP_UNORD_Q>(s, s)
         | _mm512_cmp_pd_mask::<_CMP_GT_OQ>(s, _mm512_set1_pd(f64::MAX));
@@ -699,11 +717,7 @@ fn setups<const MIP: u8>(lod: &Lod, o: &SamplerOptions, q8: &[Query; 8], out: &m
     for x in &f[2..6] {
         fin &= _mm512_cmp_pd_mask::<_CMP_LE_OQ>(_mm512_abs_pd(*x), max);
     }
-    let (wf, hf) = (_mm512_set1_pd(lod.wf), _mm512_set1_pd(lod.hf));
-    let (ax, ay) = (_mm512_mul_pd(f[2], wf), _mm512_mul_pd(f[3], hf));
-    let (bx, by) = (_mm512_mul_pd(f[4], wf), _mm512_mul_pd(f[5], hf));
-    let rx2 = _mm512_add_pd(_mm512_mul_pd(ax, ax), _mm512_mul_pd(ay, ay));
-    let ry2 = _mm512_add_pd(_mm512_mul_pd(bx, bx), _mm512_mul_pd(by, by));
+    let (rx2, ry2) = square_lens(lod, &f);
     let (rho_x, rho_y) = (_mm512_sqrt_pd(rx2), _mm512_sqrt_pd(ry2));
     let ge = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(rx2, ry2);
     let max2 = _mm512_mask_blend_pd(ge, ry2, rx2);
@@ -888,10 +902,7 @@ pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
             let bh = blocks::<P>(&ls, hi, f[0], f[1]);
             let mut fast = ok & bh.inside;
             if MIP == MIP_LINEAR {
-                // Lanes that blend a second level (δ > 0 and a different
-                // level).
-                let two = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(delta, _mm256_setzero_ps())
-                    & _mm512_cmpneq_epi64_mask(lo, hi);
+                let two = blends_two(delta, hi, lo);
                 let bl = blocks::<P>(&ls, lo, f[0], f[1]);
                 fast &= !two | bl.inside;
                 stage(s, &bh, Some(&bl), delta, fast, two & fast);
@@ -1086,10 +1097,7 @@ fn stage_probes<P: Pixel, const MIP: u8, const N: usize>(
     let bh = blocks::<P>(ls, hi, u, v);
     let fast = live & bh.inside;
     if MIP == MIP_LINEAR {
-        // As `isotropic`: lanes that blend a second level.
-        let two = _mm256_cmp_ps_mask::<_CMP_GT_OQ>(delta, _mm256_setzero_ps())
-            & _mm512_cmpneq_epi64_mask(lo, hi)
-            & fast;
+        let two = blends_two(delta, hi, lo) & fast;
         if two != 0 {
             let bl = blocks::<P>(ls, lo, u, v);
             let fast = fast & (!two | bl.inside);
