@@ -127,14 +127,16 @@ pub(crate) fn footprint_f64(q: &Query, wf: f64, hf: f64, o: &SamplerOptions) -> 
     }
 }
 
-/// log2 for the LOD, inlined: exact at powers of two, error below 2e-7
-/// elsewhere (GPUs keep 4–8 fractional bits of λ).
+/// log2 for the LOD, inlined: exact at powers of two, error below 2.5e-8
+/// elsewhere (GPUs keep 4–8 fractional bits of λ), and never above k for
+/// x below 2^k.
 ///
 /// `f64::log2` is a library call (which also spills every live vector
-/// register around it) and a polynomial is a long dependent chain; both
-/// cost more than the rest of a bilinear lookup. Here: the exponent, plus
-/// a linear interpolation in a 1024-entry table of log2 over the mantissa
-/// (4 KiB, computed at compile time).
+/// register around it). Here: the exponent, plus a quartic in the
+/// mantissa's position within one of 8 equal intervals of [1, 2), with the
+/// interval's coefficients from [`LOG2_POLY`]. The vector path looks the
+/// 8 coefficients up with one in-register permute each and evaluates the
+/// same operations in the same order, so both give the same bits.
 #[inline(always)]
 pub(crate) fn log2(x: f64) -> f64 {
     if !(f64::MIN_POSITIVE..=f64::MAX).contains(&x) {
@@ -147,19 +149,66 @@ pub(crate) fn log2(x: f64) -> f64 {
     let i = (mant >> (52 - LOG2_BITS)) as usize;
     let f = (mant & ((1u64 << (52 - LOG2_BITS)) - 1)) as f64
         * (1.0 / (1u64 << (52 - LOG2_BITS)) as f64);
-    let a = LOG2_TABLE[i] as f64;
-    let b = LOG2_TABLE[i + 1] as f64;
-    e + (a + f * (b - a))
+    let c = &LOG2_POLY;
+    let p = c[0][i] + f * (c[1][i] + f * (c[2][i] + f * (c[3][i] + f * c[4][i])));
+    // Rounding may lift p a few ulps above 1 just below the next power of
+    // two; capped, log2 never passes that power's exact value, so λ is
+    // never positive for ρ < 1 (p ≥ 0 holds without a cap).
+    e + if p < 1.0 { p } else { 1.0 }
 }
 
-pub(crate) const LOG2_BITS: u32 = 10;
+/// The mantissa's intervals: 2^`LOG2_BITS` of them.
+pub(crate) const LOG2_BITS: u32 = 3;
 
-/// log2(1 + i/1024), i = 0..=1024.
-pub(crate) static LOG2_TABLE: [f32; (1 << LOG2_BITS) + 1] = {
-    let mut t = [0f32; (1 << LOG2_BITS) + 1];
+/// `LOG2_POLY[k][i]`: coefficient of f^k of interval i, where
+/// log2(1 + (i + f)/8) ≈ Σ c_k·f^k for f in [0, 1]. Each quartic
+/// interpolates log2 at the five Chebyshev–Lobatto points of its interval
+/// (computed at compile time): the end points are among them, so
+/// neighbouring intervals meet, c₀ of interval 0 is exactly 0 (log2 of a
+/// power of two is its exponent) and the error stays below 2.5e-8.
+pub(crate) static LOG2_POLY: [[f64; 1 << LOG2_BITS]; 5] = {
+    const N: usize = 5;
+    let h = std::f64::consts::FRAC_1_SQRT_2 / 2.0;
+    let nodes = [0.0, 0.5 - h, 0.5, 0.5 + h, 1.0];
+    let n = 1usize << LOG2_BITS;
+    let mut t = [[0f64; 1 << LOG2_BITS]; N];
     let mut i = 0;
-    while i < t.len() {
-        t[i] = log2_series(1.0 + i as f64 / (1u64 << LOG2_BITS) as f64) as f32;
+    while i < n {
+        // Lagrange form Σ y_k·L_k(f), expanded into powers of f.
+        let mut coef = [0f64; N];
+        let mut k = 0;
+        while k < N {
+            let y = log2_series(1.0 + (i as f64 + nodes[k]) / n as f64);
+            // L_k(f) = Π_{j≠k} (f − f_j)/(f_k − f_j), built up one factor
+            // at a time (poly[d] is the coefficient of f^d).
+            let mut poly = [0f64; N];
+            poly[0] = 1.0;
+            let mut den = 1.0;
+            let mut j = 0;
+            while j < N {
+                if j != k {
+                    let mut d = N - 1;
+                    while d > 0 {
+                        poly[d] = poly[d - 1] - nodes[j] * poly[d];
+                        d -= 1;
+                    }
+                    poly[0] = -nodes[j] * poly[0];
+                    den *= nodes[k] - nodes[j];
+                }
+                j += 1;
+            }
+            let mut d = 0;
+            while d < N {
+                coef[d] += y * poly[d] / den;
+                d += 1;
+            }
+            k += 1;
+        }
+        let mut d = 0;
+        while d < N {
+            t[d][i] = coef[d];
+            d += 1;
+        }
         i += 1;
     }
     t
@@ -423,5 +472,61 @@ pub(crate) fn reduce_f64(x: f64, mode: WrapMode) -> f64 {
         WrapMode::Repeat if x.is_finite() => x - fast_floor(x) as f64,
         WrapMode::MirroredRepeat if x.is_finite() => x - 2.0 * fast_floor(0.5 * x) as f64,
         _ => x,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Against the library log2 over [1, 2) on a dense grid and with
+    /// exponents from the whole normal range: error below 2.5e-8.
+    #[test]
+    fn log2_is_close_to_the_library() {
+        let mut worst = 0f64;
+        let n = 1 << 18;
+        for k in 0..n {
+            let m = 1.0 + (k as f64 + 0.37) / n as f64;
+            for e in [-1000, -3, 0, 1, 17, 1000] {
+                let x = m * 2f64.powi(e);
+                worst = worst.max((log2(x) - x.log2()).abs());
+            }
+        }
+        assert!(worst < 2.5e-8, "worst error {worst:e}");
+    }
+
+    /// log2(2^k) = k exactly, so λ lands exactly on k at ρ = 2^k and on
+    /// k + 0.5 at ρ² = 2^(2k+1).
+    #[test]
+    fn log2_is_exact_at_powers_of_two() {
+        for k in -1022..=1023 {
+            assert_eq!(log2(2f64.powi(k)), k as f64, "2^{k}");
+        }
+    }
+
+    /// Never above k just below 2^k (so λ ≤ 0, magnification, whenever
+    /// ρ < 1), and
+    /// non-decreasing on a fine grid of [1, 2].
+    #[test]
+    fn log2_stays_below_the_next_power_of_two() {
+        for k in -1021..=1023 {
+            let below = f64::from_bits(2f64.powi(k).to_bits() - 1);
+            for x in [below, f64::from_bits(below.to_bits() - 1)] {
+                assert!(log2(x) <= k as f64, "{x:e}");
+            }
+        }
+        let xs: Vec<f64> = (0..=200_000).map(|k| 1.0 + k as f64 / 200_000.0).collect();
+        for w in xs.windows(2) {
+            assert!(log2(w[0]) <= log2(w[1]), "{} {}", w[0], w[1]);
+        }
+    }
+
+    #[test]
+    fn log2_hands_the_rest_to_the_library() {
+        assert_eq!(log2(0.0), f64::NEG_INFINITY);
+        assert_eq!(log2(f64::INFINITY), f64::INFINITY);
+        assert!(log2(f64::NAN).is_nan());
+        let sub = f64::MIN_POSITIVE / 4.0;
+        assert_eq!(log2(sub), sub.log2());
     }
 }

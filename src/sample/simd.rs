@@ -6,7 +6,7 @@
 //! # Same answers, bit for bit
 //! These paths perform the portable code's operations on the same values
 //! in the same order — `f64` positions, the exponent-based nearest-mip
-//! rule, the table `log2`, `f32` blends as separate multiplies and adds
+//! rule, the piecewise-quartic `log2`, `f32` blends as separate multiplies and adds
 //! (no fused multiply-add) — so they return exactly what the portable
 //! code returns; `tests/sample_simd.rs` compares the two on random and
 //! extreme queries. Only the way the work is spread over registers
@@ -32,12 +32,12 @@
 //! Two passes rather than one loop from query to colour: each loop's
 //! iterations are short and independent, so the core overlaps them.
 //!
-//! No gathers for texels: on the machines measured they cost about two
-//! cycles per element, more than the loads and table look-ups above (the
-//! table `log2` of the trilinear level does gather).
+//! No gathers: on the machines measured they cost about two cycles per
+//! element, more than the loads and table look-ups above (the `log2` of
+//! the trilinear level permutes its coefficients in registers).
 //!
 //! A lane whose block is not inside its level (NaN or huge coordinates,
-//! edge crossings, a λ the table `log2` does not cover) reads a block of
+//! edge crossings, a ρ outside the normal `f64` range) reads a block of
 //! zeros instead and is then handed to the portable code, which handles
 //! every case; so are the queries of a slice's last, partial block.
 
@@ -51,7 +51,7 @@ use std::sync::OnceLock;
 use super::aniso::Setup;
 use super::bilinear::Lin;
 use super::fetch::{Addressing, Chain, Lut8, Pixel};
-use super::footprint::{LOG2_BITS, LOG2_TABLE, Lod, Plan, UNBOUNDED_TEXELS};
+use super::footprint::{LOG2_BITS, LOG2_POLY, Lod, Plan, UNBOUNDED_TEXELS};
 use super::trace::NoTrace;
 use super::trilinear::{self, MIP_LINEAR, MIP_NEAREST};
 use super::{Query, SamplerOptions, aniso};
@@ -597,8 +597,9 @@ fn clamp_pd(x: __m512d, lo: f64, hi: f64) -> __m512d {
     _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_GT_OQ>(x, hi), x, hi)
 }
 
-/// The table `log2` of `footprint::log2` per lane, and the lanes it
-/// covers (normal, finite x); the others need the library `log2`.
+/// `footprint::log2` per lane, and the lanes it covers (normal, finite
+/// x); the others need the library `log2`. The coefficients of each
+/// lane's interval come from one in-register permute per table.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn log2(x: __m512d) -> (__m512d, u8) {
@@ -610,6 +611,8 @@ fn log2(x: __m512d) -> (__m512d, u8) {
         _mm512_set1_epi64(1023),
     ));
     let mant = _mm512_and_si512(bits, _mm512_set1_epi64((1 << 52) - 1));
+    // The interval, 0 … 7: `permutexvar` reads the low 3 bits of each
+    // 64-bit index.
     let i = _mm512_srli_epi64::<{ 52 - LOG2_BITS }>(mant);
     let f = _mm512_mul_pd(
         _mm512_cvtepi64_pd(_mm512_and_si512(
@@ -618,17 +621,29 @@ fn log2(x: __m512d) -> (__m512d, u8) {
         )),
         _mm512_set1_pd(1.0 / (1u64 << (52 - LOG2_BITS)) as f64),
     );
-    let t = LOG2_TABLE.as_ptr();
-    // SAFETY: i = mant >> 42 ≤ 1023 for every lane (mant < 2^52) and the
-    // table has 1025 entries, so i and i + 1 are in bounds.
-    let (a, b) = unsafe {
-        (
-            _mm512_cvtps_pd(_mm512_i64gather_ps::<4>(i, t)),
-            _mm512_cvtps_pd(_mm512_i64gather_ps::<4>(i, t.add(1))),
-        )
-    };
-    let r = _mm512_add_pd(e, _mm512_add_pd(a, _mm512_mul_pd(f, _mm512_sub_pd(b, a))));
+    // Horner's rule from the top coefficient, as `footprint::log2`.
+    let p = poly_term(4, i, f, _mm512_setzero_pd());
+    let p = poly_term(3, i, f, p);
+    let p = poly_term(2, i, f, p);
+    let p = poly_term(1, i, f, p);
+    let p = poly_term(0, i, f, p);
+    // `if p < 1.0 { p } else { 1.0 }`: p is never NaN here.
+    let r = _mm512_add_pd(e, _mm512_min_pd(p, _mm512_set1_pd(1.0)));
     (r, ok)
+}
+
+/// `c_k[i] + f·acc` per lane, the coefficient from `LOG2_POLY[k]`
+/// (`c_4[i]` alone for k = 4, where `acc` is 0 and not read).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn poly_term(k: usize, i: __m512i, f: __m512d, acc: __m512d) -> __m512d {
+    // SAFETY: a 64-byte load of an 8-entry `f64` array.
+    let c = _mm512_permutexvar_pd(i, unsafe { _mm512_loadu_pd(LOG2_POLY[k].as_ptr()) });
+    if k == 4 {
+        c
+    } else {
+        _mm512_add_pd(c, _mm512_mul_pd(f, acc))
+    }
 }
 
 /// The plan of 8 isotropic lookups, as `trilinear::plan::<Lin, MIP>`:
@@ -706,8 +721,7 @@ fn levels<const MIP: u8>(lambda: __m256, q: usize) -> (__m512i, __m512i, __m256)
 }
 
 /// `aniso::setup` of 8 queries into `out`: the footprint (`footprint_f64`)
-/// lane-wise; lanes with a non-finite derivative or a ρ the table `log2`
-/// does not cover take the portable setup.
+/// lane-wise; lanes with a non-finite derivative or a ρ outside the normal `f64` range take the portable setup.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn setups<const MIP: u8>(lod: &Lod, o: &SamplerOptions, q8: &[Query; 8], out: &mut [Setup]) {
