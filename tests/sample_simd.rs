@@ -86,6 +86,19 @@ fn options() -> Vec<SamplerOptions> {
             },
             ..base
         });
+        // Clamps that pin every lookup: below level 0 (magnification
+        // only) and beyond the last level of every chain here.
+        v.push(SamplerOptions {
+            lod_min: -3.0,
+            lod_max: -0.25,
+            ..base
+        });
+        v.push(SamplerOptions {
+            lod_min: 20.0,
+            lod_max: 40.0,
+            lod_bias: 2.5,
+            ..base
+        });
     }
     v
 }

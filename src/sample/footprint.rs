@@ -360,6 +360,12 @@ pub(crate) struct Lod {
     /// 4^lodMin and 4^lodMax.
     pub y_min: f64,
     pub y_max: f64,
+    /// The same clamp narrowed to [1, 4^q]: y clamped to these bounds
+    /// gives c ∈ [0, 2q], so the nearest level is ⌊c/2⌋ with no clamp of
+    /// its own (the vector path's route to the same level; lodMin ≤ lodMax
+    /// makes the two clamps nest).
+    pub near_min: f64,
+    pub near_max: f64,
     /// Wrap modes, for [`Lod::reduce`].
     wrap_u: WrapMode,
     wrap_v: WrapMode,
@@ -369,13 +375,21 @@ impl Lod {
     /// Prepare the rules of `o` for a chain of `levels` levels whose level
     /// 0 is `wf × hf`.
     pub fn new(o: &SamplerOptions, wf: f64, hf: f64, levels: usize) -> Lod {
+        let q = levels - 1;
+        let (y_min, y_max) = (
+            exp2_split(2.0 * o.lod_min as f64),
+            exp2_split(2.0 * o.lod_max as f64),
+        );
+        let top = 2f64.powi(2 * q as i32);
         Lod {
             wf,
             hf,
-            q: levels - 1,
+            q,
             scale: exp2_split(2.0 * o.lod_bias as f64).clamp(2f64.powi(-1000), 2f64.powi(1000)),
-            y_min: exp2_split(2.0 * o.lod_min as f64),
-            y_max: exp2_split(2.0 * o.lod_max as f64),
+            y_min,
+            y_max,
+            near_min: y_min.clamp(1.0, top),
+            near_max: y_max.clamp(1.0, top),
             wrap_u: o.wrap.u,
             wrap_v: o.wrap.v,
         }

@@ -85,19 +85,16 @@ pub(crate) fn fits<P: Pixel>(c: &Chain<P>) -> bool {
 }
 
 /// Per-level constants as lane tables (index = level), two registers of
-/// 8 levels each.
+/// 8 levels each. The sizes as `f64`, `w − 1`, `h − 1` and the bytes per
+/// row follow from `w` and `h` with a conversion or an add, which run on
+/// either vector port, where a second table look-up would take the
+/// shuffle port the texel decode needs.
 struct Levels {
-    wf: [__m512d; 2],
-    hf: [__m512d; 2],
-    /// `w − 1` and `h − 1`: a block's first index must be below them.
-    wm1: [__m512i; 2],
-    hm1: [__m512i; 2],
     w: [__m512i; 2],
+    h: [__m512i; 2],
     /// Address of the level's first texel (its provenance exposed, see
     /// [`read`]).
     base: [__m512i; 2],
-    /// Bytes per row.
-    row: [__m512i; 2],
 }
 
 /// The per-level constants of a chain as plain arrays (index = level),
@@ -107,10 +104,8 @@ struct Levels {
 /// move.
 #[derive(Clone, Debug)]
 pub(crate) struct LevelTable {
-    wf: [f64; 16],
-    hf: [f64; 16],
-    /// `w − 1`, `h − 1`, `w`, the level's address, bytes per row.
-    int: [[i64; 16]; 5],
+    /// `w`, `h`, the level's address.
+    int: [[i64; 16]; 3],
 }
 
 impl LevelTable {
@@ -120,20 +115,14 @@ impl LevelTable {
         if !(available() && fits(c)) {
             return None;
         }
-        let mut t = LevelTable {
-            wf: [0.0; 16],
-            hf: [0.0; 16],
-            int: [[0; 16]; 5],
-        };
-        let size = std::mem::size_of::<P>() as i64;
+        let mut t = LevelTable { int: [[0; 16]; 3] };
         for (k, l) in c.levels.iter().enumerate() {
-            t.wf[k] = l.wf;
-            t.hf[k] = l.hf;
-            t.int[0][k] = l.w as i64 - 1;
-            t.int[1][k] = l.h as i64 - 1;
-            t.int[2][k] = l.w as i64;
-            t.int[3][k] = l.texels.as_ptr().expose_provenance() as i64;
-            t.int[4][k] = l.w as i64 * size;
+            // `blocks` converts these back: `wf` and `hf` are the sizes
+            // as `f64`, exactly.
+            debug_assert_eq!((l.wf, l.hf), (l.w as f64, l.h as f64));
+            t.int[0][k] = l.w as i64;
+            t.int[1][k] = l.h as i64;
+            t.int[2][k] = l.texels.as_ptr().expose_provenance() as i64;
         }
         Some(t)
     }
@@ -144,27 +133,10 @@ impl Levels {
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
     fn new(t: &LevelTable) -> Levels {
         Levels {
-            wf: pd2(&t.wf),
-            hf: pd2(&t.hf),
-            wm1: epi64x2(&t.int[0]),
-            hm1: epi64x2(&t.int[1]),
-            w: epi64x2(&t.int[2]),
-            base: epi64x2(&t.int[3]),
-            row: epi64x2(&t.int[4]),
+            w: epi64x2(&t.int[0]),
+            h: epi64x2(&t.int[1]),
+            base: epi64x2(&t.int[2]),
         }
-    }
-}
-
-/// 16 values as two registers.
-#[inline]
-#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
-fn pd2(a: &[f64; 16]) -> [__m512d; 2] {
-    // SAFETY: two unaligned 64-byte loads inside the 128-byte array.
-    unsafe {
-        [
-            _mm512_loadu_pd(a.as_ptr()),
-            _mm512_loadu_pd(a.as_ptr().add(8)),
-        ]
     }
 }
 
@@ -179,12 +151,6 @@ fn epi64x2(a: &[i64; 16]) -> [__m512i; 2] {
             _mm512_loadu_epi64(a.as_ptr().add(8)),
         ]
     }
-}
-
-#[inline]
-#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
-fn look_pd(t: &[__m512d; 2], idx: __m512i) -> __m512d {
-    _mm512_permutex2var_pd(t[0], idx, t[1])
 }
 
 #[inline]
@@ -209,9 +175,10 @@ struct Blocks {
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn blocks<P: Pixel>(ls: &Levels, lvl: __m512i, u: __m512d, v: __m512d) -> Blocks {
+    let (w, h) = (look_epi64(&ls.w, lvl), look_epi64(&ls.h, lvl));
     let half = _mm512_set1_pd(0.5);
-    let x = _mm512_sub_pd(_mm512_mul_pd(u, look_pd(&ls.wf, lvl)), half);
-    let y = _mm512_sub_pd(_mm512_mul_pd(v, look_pd(&ls.hf, lvl)), half);
+    let x = _mm512_sub_pd(_mm512_mul_pd(u, _mm512_cvtepi64_pd(w)), half);
+    let y = _mm512_sub_pd(_mm512_mul_pd(v, _mm512_cvtepi64_pd(h)), half);
     // floor(x) as an integer in one conversion rounding down. NaN, ±∞
     // and values beyond i64 convert to i64::MIN: huge as unsigned, so
     // outside every level, as `floor_fast` makes them. For lanes inside a
@@ -220,17 +187,19 @@ fn blocks<P: Pixel>(ls: &Levels, lvl: __m512i, u: __m512d, v: __m512d) -> Blocks
     let i0 = _mm512_cvt_roundpd_epi64::<FLOOR>(x);
     let j0 = _mm512_cvt_roundpd_epi64::<FLOOR>(y);
     let (fx, fy) = (_mm512_cvtepi64_pd(i0), _mm512_cvtepi64_pd(j0));
-    let inside = _mm512_cmplt_epu64_mask(i0, look_epi64(&ls.wm1, lvl))
-        & _mm512_cmplt_epu64_mask(j0, look_epi64(&ls.hm1, lvl));
+    let one = _mm512_set1_epi64(1);
+    // A block's first index must be below w − 1 and h − 1.
+    let inside = _mm512_cmplt_epu64_mask(i0, _mm512_sub_epi64(w, one))
+        & _mm512_cmplt_epu64_mask(j0, _mm512_sub_epi64(h, one));
     // Lanes inside the level have 0 ≤ i0, j0 and w below 2^32, so a
     // 32 × 32 → 64-bit multiply gives j0·w (other lanes' addresses are
     // replaced before use). The texel size is a power of two: a shift.
-    let k = _mm512_add_epi64(_mm512_mul_epu32(j0, look_epi64(&ls.w, lvl)), i0);
+    let k = _mm512_add_epi64(_mm512_mul_epu32(j0, w), i0);
     let shift = _mm512_set1_epi64(std::mem::size_of::<P>().trailing_zeros() as i64);
     let top = _mm512_add_epi64(look_epi64(&ls.base, lvl), _mm512_sllv_epi64(k, shift));
     Blocks {
         top,
-        bot: _mm512_add_epi64(top, look_epi64(&ls.row, lvl)),
+        bot: _mm512_add_epi64(top, _mm512_sllv_epi64(w, shift)),
         al: _mm512_cvtpd_ps(_mm512_sub_pd(x, fx)),
         be: _mm512_cvtpd_ps(_mm512_sub_pd(y, fy)),
         inside,
@@ -580,21 +549,22 @@ fn blends_two(delta: __m256, hi: __m512i, lo: __m512i) -> u8 {
 fn rho2(lod: &Lod, f: &[__m512d; 6]) -> __m512d {
     let (rx2, ry2) = square_lens(lod, f);
     let s = _mm512_add_pd(rx2, ry2);
-    let bad = _mm512_cmp_pd_mask::<_CMP_UNORD_Q>(s, s)
-        | _mm512_cmp_pd_mask::<_CMP_GT_OQ>(s, _mm512_set1_pd(f64::MAX));
-    let ge = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(rx2, ry2);
-    let m = _mm512_mask_blend_pd(ge, ry2, rx2);
+    // NaN or above f64::MAX in one compare ("not ≤", true when unordered).
+    let bad = _mm512_cmp_pd_mask::<_CMP_NLE_UQ>(s, _mm512_set1_pd(f64::MAX));
+    // `vmaxpd a, b` is `a > b ? a : b`: `rx2 >= ry2 ? rx2 : ry2` for the
+    // lanes kept (neither is NaN there).
+    let m = _mm512_max_pd(ry2, rx2);
     _mm512_mask_blend_pd(bad, m, _mm512_set1_pd(UNBOUNDED_TEXELS * UNBOUNDED_TEXELS))
 }
 
 /// `x < lo ? lo : x` then `x > hi ? hi : x` (`f64::clamp` for non-NaN
-/// bounds; NaN passes through).
+/// bounds; NaN passes through): `vmaxpd lo, x` is `lo > x ? lo : x` and
+/// returns x when either is NaN, and `vminpd` likewise.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn clamp_pd(x: __m512d, lo: f64, hi: f64) -> __m512d {
-    let (lo, hi) = (_mm512_set1_pd(lo), _mm512_set1_pd(hi));
-    let x = _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_LT_OQ>(x, lo), x, lo);
-    _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_GT_OQ>(x, hi), x, hi)
+    let x = _mm512_max_pd(_mm512_set1_pd(lo), x);
+    _mm512_min_pd(_mm512_set1_pd(hi), x)
 }
 
 /// `footprint::log2` per lane, and the lanes it covers (normal, finite
@@ -658,21 +628,19 @@ fn plans<const MIP: u8>(
 ) -> (__m512i, __m512i, __m256, u8) {
     let r2 = rho2(lod, f);
     if MIP == MIP_NEAREST {
-        // `Lod::plan_nearest`: the level from the exponent of y.
+        // `Lod::plan_nearest`'s level, with y clamped to [near_min,
+        // near_max] ⊆ [1, 4^q] so that c ∈ [0, 2q] and d = c >> 1 needs no
+        // clamp (the same level: see `Lod::near_min`).
         let y = clamp_pd(
             _mm512_mul_pd(r2, _mm512_set1_pd(lod.scale)),
-            lod.y_min,
-            lod.y_max,
+            lod.near_min,
+            lod.near_max,
         );
         let e = _mm512_srli_epi64::<52>(_mm512_add_epi64(
             _mm512_castpd_si512(y),
             _mm512_set1_epi64((1 << 52) - 1),
         ));
-        let c = _mm512_sub_epi64(e, _mm512_set1_epi64(1023));
-        let d = _mm512_min_epi64(
-            _mm512_max_epi64(_mm512_srai_epi64::<1>(c), _mm512_setzero_si512()),
-            _mm512_set1_epi64(lod.q as i64),
-        );
+        let d = _mm512_srli_epi64::<1>(_mm512_sub_epi64(e, _mm512_set1_epi64(1023)));
         (d, d, _mm256_setzero_ps(), 0xFF)
     } else {
         // `Lod::lambda`, then `Plan::at(λ, q, Linear)`.
