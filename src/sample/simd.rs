@@ -869,28 +869,26 @@ pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
     queries: &[Query],
     out: &mut [[f32; 4]],
 ) {
+    const N: usize = 8 * CHUNK;
     let ls = Levels::new(table);
     let mut staged = [Staged::EMPTY; CHUNK];
+    let mut plans_ = Probes::<N>::EMPTY;
+    let mut ok = [0u8; CHUNK];
     let whole = queries.len() / 8 * 8;
-    for (qc, oc) in queries[..whole]
-        .chunks(8 * CHUNK)
-        .zip(out[..whole].chunks_mut(8 * CHUNK))
-    {
+    for (qc, oc) in queries[..whole].chunks(N).zip(out[..whole].chunks_mut(N)) {
         let nb = qc.len() / 8;
-        for (q8, s) in qc.chunks_exact(8).zip(&mut staged) {
+        // The footprints and levels first, then the blocks: two short
+        // loops overlap better than one with the whole chain from query to
+        // address (the level's `log2` alone is a chain of 10 operations).
+        for (b, (q8, ok)) in qc.chunks_exact(8).zip(&mut ok).enumerate() {
             let q8: &[Query; 8] = q8.try_into().expect("8 queries");
             let f = fields(q8);
-            let (hi, lo, delta, ok) = plans::<MIP>(lod, opts, &f);
-            let bh = blocks::<P>(&ls, hi, f[0], f[1]);
-            let mut fast = ok & bh.inside;
-            if MIP == MIP_LINEAR {
-                let two = blends_two(delta, hi, lo);
-                let bl = blocks::<P>(&ls, lo, f[0], f[1]);
-                fast &= !two | bl.inside;
-                stage(s, &bh, Some(&bl), delta, fast, two & fast);
-            } else {
-                stage(s, &bh, None, delta, fast, 0);
-            }
+            let (hi, lo, delta, lanes) = plans::<MIP>(lod, opts, &f);
+            plans_.store(8 * b, f[0], f[1], hi, lo, delta);
+            *ok = lanes;
+        }
+        for (b, (s, ok)) in staged[..nb].iter_mut().zip(&ok).enumerate() {
+            stage_probes::<P, MIP, N>(&ls, &plans_, 8 * b, *ok, s);
         }
         for (s, o8) in staged[..nb].iter().zip(oc.chunks_exact_mut(8)) {
             for h in 0..2 {
@@ -1044,14 +1042,49 @@ pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
     }
 }
 
-/// The probes of a chunk of footprint-assembly lookups, one entry per
-/// probe: position, levels and blend.
+/// The probes of a chunk of footprint-assembly lookups (or the lookups of
+/// a chunk of isotropic ones), one entry per probe: position, levels and
+/// blend.
 struct Probes<const N: usize> {
     u: [f64; N],
     v: [f64; N],
     hi: [i64; N],
     lo: [i64; N],
     delta: [f32; N],
+}
+
+impl<const N: usize> Probes<N> {
+    const EMPTY: Probes<N> = Probes {
+        u: [0.0; N],
+        v: [0.0; N],
+        hi: [0; N],
+        lo: [0; N],
+        delta: [0.0; N],
+    };
+
+    /// Entries `first … first + 7` from registers.
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+    fn store(
+        &mut self,
+        first: usize,
+        u: __m512d,
+        v: __m512d,
+        hi: __m512i,
+        lo: __m512i,
+        delta: __m256,
+    ) {
+        let end = first + 8;
+        // SAFETY: 64- and 32-byte stores of 8 entries inside the arrays
+        // (the slices are 8 long, or the indexing panics first).
+        unsafe {
+            _mm512_storeu_pd(self.u[first..end].as_mut_ptr(), u);
+            _mm512_storeu_pd(self.v[first..end].as_mut_ptr(), v);
+            _mm512_storeu_epi64(self.hi[first..end].as_mut_ptr(), hi);
+            _mm512_storeu_epi64(self.lo[first..end].as_mut_ptr(), lo);
+            _mm256_storeu_ps(self.delta[first..end].as_mut_ptr(), delta);
+        }
+    }
 }
 
 /// Stages probes `first … first + 7` (the lanes in `live`) into `s`.
