@@ -845,9 +845,10 @@ fn colours<P: Pixel, const MIP: u8>(c: &Chain<P>, s: &Staged, h: usize) -> __m51
     // SAFETY: as above, with the lanes in `two`.
     let d2 = unsafe { group::<P>(&c.lut, &s.top2, &s.bot2, h) };
     let r2 = bilerp(d2, ps8(&s.w[2]), ps8(&s.w[3]), h);
-    let delta = ps8(&s.w[4]);
-    let omd = _mm256_sub_ps(_mm256_set1_ps(1.0), delta);
-    let mixed = lerp16(r, r2, spread(omd, h), spread(delta, h));
+    // 1 − δ after spreading: one permute fewer, the same values.
+    let delta = spread(ps8(&s.w[4]), h);
+    let omd = _mm512_sub_ps(_mm512_set1_ps(1.0), delta);
+    let mixed = lerp16(r, r2, omd, delta);
     _mm512_mask_blend_ps(m, r, mixed)
 }
 
