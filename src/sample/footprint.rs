@@ -150,7 +150,9 @@ pub(crate) fn log2(x: f64) -> f64 {
     let f = (mant & ((1u64 << (52 - LOG2_BITS)) - 1)) as f64
         * (1.0 / (1u64 << (52 - LOG2_BITS)) as f64);
     let c = &LOG2_POLY;
-    let p = c[0][i] + f * (c[1][i] + f * (c[2][i] + f * (c[3][i] + f * c[4][i])));
+    // Estrin's scheme: a shorter dependency chain than Horner's rule.
+    let f2 = f * f;
+    let p = (c[0][i] + c[1][i] * f) + f2 * ((c[2][i] + c[3][i] * f) + c[4][i] * f2);
     // Rounding may lift p a few ulps above 1 just below the next power of
     // two; capped, log2 never passes that power's exact value, so λ is
     // never positive for ρ < 1 (p ≥ 0 holds without a cap).

@@ -591,29 +591,23 @@ fn log2(x: __m512d) -> (__m512d, u8) {
         )),
         _mm512_set1_pd(1.0 / (1u64 << (52 - LOG2_BITS)) as f64),
     );
-    // Horner's rule from the top coefficient, as `footprint::log2`.
-    let p = poly_term(4, i, f, _mm512_setzero_pd());
-    let p = poly_term(3, i, f, p);
-    let p = poly_term(2, i, f, p);
-    let p = poly_term(1, i, f, p);
-    let p = poly_term(0, i, f, p);
+    // Estrin's scheme, as `footprint::log2`.
+    let f2 = _mm512_mul_pd(f, f);
+    let lo = _mm512_add_pd(coefficient(0, i), _mm512_mul_pd(coefficient(1, i), f));
+    let mid = _mm512_add_pd(coefficient(2, i), _mm512_mul_pd(coefficient(3, i), f));
+    let hi = _mm512_add_pd(mid, _mm512_mul_pd(coefficient(4, i), f2));
+    let p = _mm512_add_pd(lo, _mm512_mul_pd(f2, hi));
     // `if p < 1.0 { p } else { 1.0 }`: p is never NaN here.
     let r = _mm512_add_pd(e, _mm512_min_pd(p, _mm512_set1_pd(1.0)));
     (r, ok)
 }
 
-/// `c_k[i] + f·acc` per lane, the coefficient from `LOG2_POLY[k]`
-/// (`c_4[i]` alone for k = 4, where `acc` is 0 and not read).
+/// `LOG2_POLY[k][i]` per lane.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
-fn poly_term(k: usize, i: __m512i, f: __m512d, acc: __m512d) -> __m512d {
+fn coefficient(k: usize, i: __m512i) -> __m512d {
     // SAFETY: a 64-byte load of an 8-entry `f64` array.
-    let c = _mm512_permutexvar_pd(i, unsafe { _mm512_loadu_pd(LOG2_POLY[k].as_ptr()) });
-    if k == 4 {
-        c
-    } else {
-        _mm512_add_pd(c, _mm512_mul_pd(f, acc))
-    }
+    _mm512_permutexvar_pd(i, unsafe { _mm512_loadu_pd(LOG2_POLY[k].as_ptr()) })
 }
 
 /// The plan of 8 isotropic lookups, as `trilinear::plan::<Lin, MIP>`:
