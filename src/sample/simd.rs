@@ -115,7 +115,12 @@ impl LevelTable {
         if !(available() && fits(c)) {
             return None;
         }
-        let mut t = LevelTable { int: [[0; 16]; 3] };
+        // Entries past the last level read as 1 × 1 (no block fits), so a
+        // level index beyond the chain could only send a lane to the
+        // portable path; the plans clamp every index to the chain anyway.
+        let mut t = LevelTable {
+            int: [[1; 16], [1; 16], [0; 16]],
+        };
         for (k, l) in c.levels.iter().enumerate() {
             // `blocks` converts these back: `wf` and `hf` are the sizes
             // as `f64`, exactly.
