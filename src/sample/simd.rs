@@ -6,10 +6,12 @@
 //! # Same answers, bit for bit
 //! These paths perform the portable code's operations on the same values
 //! in the same order — `f64` positions, the exponent-based nearest-mip
-//! rule, the piecewise-quartic `log2`, `f32` blends as separate multiplies and adds
-//! (no fused multiply-add) — so they return exactly what the portable
-//! code returns; `tests/sample_simd.rs` compares the two on random and
-//! extreme queries. Only the way the work is spread over registers
+//! rule, the piecewise-quartic `log2`, `f32` blends as separate
+//! multiplies and adds (no fused multiply-add) — so they return exactly
+//! what the portable code returns; `tests/sample_simd.rs` compares the two
+//! on random and extreme queries, and the unit tests below compare the
+//! lane-wise `log2` and level plans with the portable ones directly (a
+//! wrong level can hide behind the portable fallback). Only the way the work is spread over registers
 //! differs:
 //!
 //! - **First pass, per block of 8 queries (or 8 probes)**, one lane
@@ -37,9 +39,10 @@
 //! the trilinear level permutes its coefficients in registers).
 //!
 //! A lane whose block is not inside its level (NaN or huge coordinates,
-//! edge crossings, a ρ outside the normal `f64` range) reads a block of
-//! zeros instead and is then handed to the portable code, which handles
-//! every case; so are the queries of a slice's last, partial block.
+//! edge crossings, a ρ² of zero or outside the normal `f64` range) reads a
+//! block of zeros instead and is then handed to the portable code, which
+//! handles every case; so are the queries of a slice's last, partial
+//! block.
 
 // Intrinsics: every `unsafe` block below says which features are enabled
 // and why its memory accesses stay in bounds.
@@ -86,9 +89,9 @@ pub(crate) fn fits<P: Pixel>(c: &Chain<P>) -> bool {
 
 /// Per-level constants as lane tables (index = level), two registers of
 /// 8 levels each. The sizes as `f64`, `w − 1`, `h − 1` and the bytes per
-/// row follow from `w` and `h` with a conversion or an add, which run on
-/// either vector port, where a second table look-up would take the
-/// shuffle port the texel decode needs.
+/// row follow from `w` and `h` by a conversion, a subtract or a shift,
+/// which run on either vector port, where more table look-ups would take
+/// the shuffle port the texel decode needs.
 struct Levels {
     w: [__m512i; 2],
     h: [__m512i; 2],
@@ -688,7 +691,8 @@ fn levels<const MIP: u8>(lambda: __m256, q: usize) -> (__m512i, __m512i, __m256)
 }
 
 /// `aniso::setup` of 8 queries into `out`: the footprint (`footprint_f64`)
-/// lane-wise; lanes with a non-finite derivative or a ρ outside the normal `f64` range take the portable setup.
+/// lane-wise; lanes with a non-finite derivative or a ρmax²/η² of zero or
+/// outside the normal `f64` range take the portable setup.
 #[inline]
 #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
 fn setups<const MIP: u8>(lod: &Lod, o: &SamplerOptions, q8: &[Query; 8], out: &mut [Setup]) {
@@ -1121,4 +1125,159 @@ fn stage_probes<P: Pixel, const MIP: u8, const N: usize>(
         }
     }
     stage(s, &bh, None, delta, fast, 0);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sample::footprint;
+
+    /// A xorshift generator (fixed seed per test).
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+    }
+
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+    fn log2_lanes(x: &[f64; 8]) -> ([f64; 8], u8) {
+        // SAFETY: a 64-byte load of 8 `f64`s and a store into 8.
+        let (r, ok) = log2(unsafe { _mm512_loadu_pd(x.as_ptr()) });
+        let mut out = [0f64; 8];
+        // SAFETY: as above.
+        unsafe { _mm512_storeu_pd(out.as_mut_ptr(), r) };
+        (out, ok)
+    }
+
+    /// Every lane it covers equals `footprint::log2` bit for bit: powers
+    /// of two and their neighbours (where the cap acts), both sides of
+    /// every interval join, random bit patterns; and it covers exactly the
+    /// normal finite values.
+    #[test]
+    fn log2_lanes_equal_the_portable_log2() {
+        if !available() {
+            return;
+        }
+        let mut xs = Vec::new();
+        for k in -1022..=1023 {
+            let p = 2f64.powi(k).to_bits();
+            xs.extend([p - 2, p - 1, p, p + 1].map(f64::from_bits));
+        }
+        for k in [-40, 0, 7] {
+            for i in 1..8 {
+                let join = (2f64.powi(k) * (1.0 + i as f64 / 8.0)).to_bits();
+                xs.extend((join - 3..=join + 3).map(f64::from_bits));
+            }
+        }
+        let mut r = Rng(0x9e37_79b9_7f4a_7c15);
+        xs.extend((0..200_000).map(|_| f64::from_bits(r.next() >> 1)));
+        xs.extend([0.0, -1.0, f64::MIN_POSITIVE / 2.0, f64::INFINITY, f64::NAN]);
+        while xs.len() % 8 != 0 {
+            xs.push(1.0);
+        }
+        for c in xs.chunks_exact(8) {
+            let c: &[f64; 8] = c.try_into().unwrap();
+            // SAFETY: `available()` checked the CPU features.
+            let (got, ok) = unsafe { log2_lanes(c) };
+            for i in 0..8 {
+                let normal = (f64::MIN_POSITIVE..=f64::MAX).contains(&c[i]);
+                assert_eq!(ok >> i & 1 == 1, normal, "{:e}", c[i]);
+                if normal {
+                    let want = footprint::log2(c[i]);
+                    assert_eq!(got[i].to_bits(), want.to_bits(), "{:e}", c[i]);
+                }
+            }
+        }
+    }
+
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+    fn plan_lanes<const MIP: u8>(
+        lod: &Lod,
+        o: &SamplerOptions,
+        q8: &[Query; 8],
+    ) -> ([i64; 8], [i64; 8], [f32; 8], u8) {
+        let (hi, lo, delta, ok) = plans::<MIP>(lod, o, &fields(q8));
+        let (mut h, mut l, mut d) = ([0i64; 8], [0i64; 8], [0f32; 8]);
+        // SAFETY: stores of whole registers into arrays of their size.
+        unsafe {
+            _mm512_storeu_epi64(h.as_mut_ptr(), hi);
+            _mm512_storeu_epi64(l.as_mut_ptr(), lo);
+            _mm256_storeu_ps(d.as_mut_ptr(), delta);
+        }
+        (h, l, d, ok)
+    }
+
+    /// The lane-wise plans equal `trilinear::plan` (levels and blend) for
+    /// chains of 1 to 16 levels, LOD clamps below level 0, beyond the last
+    /// level and in between, biases, and derivatives from 0 to ∞ and NaN,
+    /// including exact powers of two (the level thresholds).
+    #[test]
+    fn plans_equal_the_portable_plans() {
+        if !available() {
+            return;
+        }
+        let mut r = Rng(0x2545_f491_4f6c_dd1d);
+        let clamps = [
+            (-1000.0, 1000.0, 0.0),
+            (-3.0, -0.25, 0.0),
+            (20.0, 40.0, 2.5),
+            (0.5, 3.0, 0.75),
+            (-1000.0, 1000.0, -1.5),
+            (1.5, 1.5, 0.0),
+            (0.0, 0.0, 0.5),
+        ];
+        for levels in [1usize, 2, 5, 12, 16] {
+            let (w, h) = (1u64 << (levels - 1), 1u64 << (levels / 2));
+            for (lod_min, lod_max, lod_bias) in clamps {
+                let o = SamplerOptions {
+                    lod_min,
+                    lod_max,
+                    lod_bias,
+                    ..SamplerOptions::trilinear()
+                };
+                let lod = Lod::new(&o, w as f64, h as f64, levels);
+                for _ in 0..400 {
+                    let q8: [Query; 8] = std::array::from_fn(|_| {
+                        let mut d = || -> f32 {
+                            match r.next() % 8 {
+                                0 => 0.0,
+                                1 => f32::NAN,
+                                2 => f32::INFINITY,
+                                // Exact powers of two over texel sizes.
+                                3 | 4 => {
+                                    let k = (r.next() % 40) as i32 - 20;
+                                    2f32.powi(k) / w as f32
+                                }
+                                _ => {
+                                    let m = (r.next() % 10_000) as f32 / 5000.0 - 1.0;
+                                    m * 2f32.powi((r.next() % 50) as i32 - 30)
+                                }
+                            }
+                        };
+                        Query::new(0.5, 0.5, d(), d(), d(), d())
+                    });
+                    // SAFETY: `available()` checked the CPU features.
+                    let near = unsafe { plan_lanes::<MIP_NEAREST>(&lod, &o, &q8) };
+                    // SAFETY: as above.
+                    let lin = unsafe { plan_lanes::<MIP_LINEAR>(&lod, &o, &q8) };
+                    for (i, q) in q8.iter().enumerate() {
+                        let want = trilinear::plan::<Lin, MIP_NEAREST>(&lod, &o, q);
+                        assert_eq!(near.3, 0xFF);
+                        assert_eq!((near.0[i], near.1[i]), (want.hi as i64, want.lo as i64));
+                        if lin.3 >> i & 1 == 1 {
+                            let want = trilinear::plan::<Lin, MIP_LINEAR>(&lod, &o, q);
+                            let got = (lin.0[i], lin.1[i], lin.2[i].to_bits());
+                            let exp = (want.hi as i64, want.lo as i64, want.delta.to_bits());
+                            assert_eq!(got, exp, "{q:?} levels {levels} {o:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
