@@ -11,8 +11,8 @@
 //! what the portable code returns; `tests/sample_simd.rs` compares the two
 //! on random and extreme queries, and the unit tests below compare the
 //! lane-wise `log2` and level plans with the portable ones directly (a
-//! wrong level can hide behind the portable fallback). Only the way the work is spread over registers
-//! differs:
+//! wrong level can hide behind the portable fallback). Only the way the
+//! work is spread over registers differs:
 //!
 //! - **First pass, per block of 8 queries (or 8 probes)**, one lane
 //!   each: the query fields transposed from the array of queries, the
@@ -876,23 +876,23 @@ pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
     const N: usize = 8 * CHUNK;
     let ls = Levels::new(table);
     let mut staged = [Staged::EMPTY; CHUNK];
-    let mut plans_ = Probes::<N>::EMPTY;
+    let mut planned = Probes::<N>::EMPTY;
     let mut ok = [0u8; CHUNK];
     let whole = queries.len() / 8 * 8;
     for (qc, oc) in queries[..whole].chunks(N).zip(out[..whole].chunks_mut(N)) {
         let nb = qc.len() / 8;
         // The footprints and levels first, then the blocks: two short
-        // loops overlap better than one with the whole chain from query to
-        // address (the level's `log2` alone is a chain of 10 operations).
+        // loops overlap better than one with the whole dependent chain from
+        // query to address (ρ², log2, clamps, levels, then the blocks).
         for (b, (q8, ok)) in qc.chunks_exact(8).zip(&mut ok).enumerate() {
             let q8: &[Query; 8] = q8.try_into().expect("8 queries");
             let f = fields(q8);
             let (hi, lo, delta, lanes) = plans::<MIP>(lod, opts, &f);
-            plans_.store(8 * b, f[0], f[1], hi, lo, delta);
+            planned.store(8 * b, f[0], f[1], hi, lo, delta);
             *ok = lanes;
         }
         for (b, (s, ok)) in staged[..nb].iter_mut().zip(&ok).enumerate() {
-            stage_probes::<P, MIP, N>(&ls, &plans_, 8 * b, *ok, s);
+            stage_probes::<P, MIP, N>(&ls, &planned, 8 * b, *ok, s);
         }
         for (s, o8) in staged[..nb].iter().zip(oc.chunks_exact_mut(8)) {
             for h in 0..2 {
