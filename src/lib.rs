@@ -53,6 +53,7 @@
 #![warn(missing_docs)]
 
 pub mod builtin;
+pub mod compress;
 mod cpu;
 pub mod error;
 pub mod io;

@@ -300,14 +300,13 @@ fn grey_and_rgb_sources_keep_their_channels_where_the_container_can() {
     }
     assert_eq!(load(&exr).base().channels(), 3);
     assert_eq!(load(&ktx).base().channels(), 3);
-    // DXGI has no RGB8: widened to RGBA with opaque alpha.
+    // sRGB RGB8 has no DXGI format: stored as R8G8B8A8_UNORM_SRGB with
+    // alpha 255 and the DX10 alpha mode "opaque", which reads back as RGB.
     let d = load(&dds);
-    assert_eq!(d.base().channels(), 4);
-    assert!(
-        d.levels
-            .iter()
-            .all(|l| l.to_linear().chunks(4).all(|p| p[3] == 1.0))
-    );
+    assert_eq!(d.base().channels(), 3);
+    assert_eq!(d.info.attribute("dds:alphaMode"), Some("opaque"));
+    let bytes = std::fs::read(&dds).unwrap();
+    assert!(bytes[148..].chunks(4).all(|p| p[3] == 255));
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! Loading and saving textures: the `image` codecs (PNG, JPEG, TIFF,
 //! Radiance HDR), OpenEXR (scanline, tiled, mip-mapped) via `exr`, KTX 2.0
-//! (written by hand, read with `ktx2`), DDS via `ddsfile`, and one PNG per
-//! mip level.
+//! (written by hand, read with `ktx2`), DDS (written and read by hand, see
+//! [`dds`]), and one PNG per mip level.
 //!
 //! Design decisions:
 //! - Files are recognised by their first bytes (EXR, KTX2, DDS magic
@@ -32,7 +32,7 @@ use half::slice::HalfFloatSliceExt;
 
 use crate::error::{Error, Result};
 use crate::mip::{self, MipChain, MipOptions, Rounding};
-use crate::texel::{ChannelType, ColorSpace, Format, Texels};
+use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::Wrap;
 
@@ -382,7 +382,7 @@ pub enum OutputKind {
     Exr,
     /// `.ktx2`: KTX 2.0, uncompressed.
     Ktx2,
-    /// `.dds`: DDS with a DX10 header, uncompressed.
+    /// `.dds`: DDS, uncompressed, legacy or DX10 header as the format needs.
     Dds,
     /// A name containing `{level}`: one PNG per level.
     PngLevels,
@@ -497,12 +497,13 @@ pub fn stored_fingerprint(path: &Path, kind: OutputKind) -> Option<String> {
     }
 }
 
-/// Widen a texture to `channels` channels: grey is replicated into RGB, a
-/// missing alpha becomes opaque. Used where a container has no format for
-/// the source layout (DDS has no RGB8, KTX2's `R8G8_SRGB` would decode
-/// alpha as sRGB).
+/// Widen a texture to `channels` channels: grey is replicated into RGB, R,G
+/// data (no alpha) gets B = 0, a missing alpha becomes opaque. Used where a
+/// container has no format for the source layout (DDS has no RGB8, PNG no
+/// two-channel colour, KTX2's `R8G8_SRGB` would decode alpha as sRGB).
 pub fn expand_channels(t: &Texture, channels: u8) -> Result<Texture> {
-    let from = t.format().channels;
+    let f = t.format();
+    let from = f.channels;
     if from == channels {
         return Ok(t.clone());
     }
@@ -511,31 +512,39 @@ pub fn expand_channels(t: &Texture, channels: u8) -> Result<Texture> {
             "cannot widen {from} channels to {channels}"
         )));
     }
-    // Source channel feeding each destination channel; `None` = opaque alpha.
-    let map: Vec<Option<usize>> = match (from, channels) {
-        (1, 3) => vec![Some(0), Some(0), Some(0)],
-        (1, 4) => vec![Some(0), Some(0), Some(0), None],
-        (2, 4) => vec![Some(0), Some(0), Some(0), Some(1)],
-        (2, 3) => vec![Some(0), Some(0), Some(0)],
-        (3, 4) => vec![Some(0), Some(1), Some(2), None],
-        _ => unreachable!("checked above"),
+    // Source channel feeding each destination channel; `None` = 0 for a
+    // colour channel, 1 (opaque) for the alpha at index 3.
+    let map: [Option<usize>; 4] = match (from, f.has_alpha()) {
+        (1, _) => [Some(0), Some(0), Some(0), None],
+        (2, true) => [Some(0), Some(0), Some(0), Some(1)],
+        (2, false) => [Some(0), Some(1), None, None],
+        _ => [Some(0), Some(1), Some(2), None],
     };
-    fn widen<T: Copy>(v: &[T], from: usize, map: &[Option<usize>], one: T) -> Vec<T> {
+    let map = &map[..channels as usize];
+    fn widen<T: Copy>(v: &[T], from: usize, map: &[Option<usize>], zero: T, one: T) -> Vec<T> {
         let mut out = Vec::with_capacity(v.len() / from * map.len());
         for px in v.chunks_exact(from) {
-            out.extend(map.iter().map(|m| m.map_or(one, |i| px[i])));
+            out.extend(map.iter().enumerate().map(|(c, m)| match m {
+                Some(i) => px[*i],
+                None if c == 3 => one,
+                None => zero,
+            }));
         }
         out
     }
-    let f = from as usize;
+    let n = from as usize;
     let texels = match t.texels() {
-        Texels::U8(v) => Texels::U8(widen(v, f, &map, u8::MAX)),
-        Texels::U16(v) => Texels::U16(widen(v, f, &map, u16::MAX)),
-        Texels::F16(v) => Texels::F16(widen(v, f, &map, half::f16::ONE)),
-        Texels::F32(v) => Texels::F32(widen(v, f, &map, 1.0)),
+        Texels::U8(v) => Texels::U8(widen(v, n, map, 0, u8::MAX)),
+        Texels::U16(v) => Texels::U16(widen(v, n, map, 0, u16::MAX)),
+        Texels::F16(v) => Texels::F16(widen(v, n, map, half::f16::ZERO, half::f16::ONE)),
+        Texels::F32(v) => Texels::F32(widen(v, n, map, 0.0, 1.0)),
     };
-    let mut format = t.format();
+    let mut format = f;
     format.channels = channels;
+    if channels == 4 && !f.has_alpha() {
+        // The added channel is an opaque alpha.
+        format.alpha = AlphaMode::Straight;
+    }
     Texture::from_texels(t.width(), t.height(), format, texels)
 }
 

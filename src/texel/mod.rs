@@ -122,6 +122,10 @@ pub enum AlphaMode {
     Straight,
     /// Colour is already multiplied by alpha (associated); filtered as is.
     Premultiplied,
+    /// No channel is alpha: the second of two or the fourth of four
+    /// channels is data (a `U,V` flow map, an `R,G` two-channel normal map,
+    /// a packed mask), filtered independently like every other channel.
+    None,
 }
 
 impl fmt::Display for AlphaMode {
@@ -129,6 +133,7 @@ impl fmt::Display for AlphaMode {
         f.write_str(match self {
             AlphaMode::Straight => "straight",
             AlphaMode::Premultiplied => "premultiplied",
+            AlphaMode::None => "none",
         })
     }
 }
@@ -139,11 +144,12 @@ impl FromStr for AlphaMode {
         Ok(match s.to_ascii_lowercase().as_str() {
             "straight" | "unassociated" => AlphaMode::Straight,
             "premultiplied" | "associated" => AlphaMode::Premultiplied,
+            "none" | "data" => AlphaMode::None,
             _ => {
                 return Err(Error::parse(
                     "alpha mode",
                     s,
-                    "expected straight or premultiplied",
+                    "expected straight, premultiplied or none",
                 ));
             }
         })
@@ -153,7 +159,9 @@ impl FromStr for AlphaMode {
 /// The full description of a texel.
 ///
 /// Channel layouts: 1 = grey (or R), 2 = grey + alpha, 3 = RGB, 4 = RGBA.
-/// The alpha channel, when present, is the last one.
+/// The alpha channel, when present, is the last one; with
+/// [`AlphaMode::None`] two channels are R, G and four are R, G, B and a
+/// fourth data channel, none of them alpha.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Format {
     /// Channels per texel, 1 to 4.
@@ -190,9 +198,10 @@ impl Format {
         self
     }
 
-    /// True when the last channel is alpha (2 or 4 channels).
+    /// True when the last channel is alpha (2 or 4 channels, alpha mode
+    /// other than [`AlphaMode::None`]).
     pub fn has_alpha(&self) -> bool {
-        self.channels == 2 || self.channels == 4
+        (self.channels == 2 || self.channels == 4) && self.alpha != AlphaMode::None
     }
 
     /// Index of the alpha channel, if any.
@@ -229,10 +238,18 @@ impl Format {
 
 impl fmt::Display for Format {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let layout = ["R", "RA", "RGB", "RGBA"][(self.channels.clamp(1, 4) - 1) as usize];
+        let layout = match (self.channels, self.has_alpha()) {
+            (1, _) => "R",
+            (2, true) => "RA",
+            (2, false) => "RG",
+            (3, _) => "RGB",
+            _ => "RGBA",
+        };
         write!(f, "{layout} {} {}", self.channel_type, self.color_space)?;
         if self.has_alpha() {
             write!(f, " {} alpha", self.alpha)?;
+        } else if self.channels == 4 {
+            f.write_str(" (A is data)")?;
         }
         Ok(())
     }
