@@ -1,19 +1,23 @@
 #!/usr/bin/env bash
 # Install the interop reference tools (OpenImageIO's oiiotool, maketx and
-# Python bindings, plus numpy) into a venv under target/, so the interop
-# checks in .ci/interop.sh and benches/cli_vs_maketx.sh run on any machine
-# of the project without anything installed by hand.
+# Python bindings, Pillow, numpy; pinned in scripts/interop-requirements.txt)
+# into a venv under target/, so the interop checks in .ci/interop.sh and
+# benches/cli_vs_maketx.sh run on any machine of the project without
+# anything installed by hand.
 #
 # Usage: scripts/setup-interop.sh            (idempotent; prints the venv bin dir)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV="${PARVO_INTEROP_VENV:-target/interop-venv}"
+REQ=scripts/interop-requirements.txt
 if [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV" >&2
 fi
-if ! "$VENV/bin/python" -c 'import OpenImageIO, numpy' 2>/dev/null \
+# Reinstall when the pinned set changes (the stamp is a copy of it).
+if ! cmp -s "$REQ" "$VENV/.requirements" \
     || [ ! -x "$VENV/bin/oiiotool" ] || [ ! -x "$VENV/bin/maketx" ]; then
-    "$VENV/bin/pip" install --quiet --disable-pip-version-check OpenImageIO numpy >&2
+    "$VENV/bin/pip" install --quiet --disable-pip-version-check -r "$REQ" >&2
+    cp "$REQ" "$VENV/.requirements"
 fi
 for tool in oiiotool maketx; do
     if [ ! -x "$VENV/bin/$tool" ]; then

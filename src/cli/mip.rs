@@ -52,6 +52,8 @@ pub enum AlphaArg {
     Straight,
     /// Colour is already multiplied by alpha (associated).
     Premultiplied,
+    /// No channel is alpha: a second or fourth channel is data.
+    None,
 }
 
 /// Output container for `--out-dir` batches.
@@ -103,7 +105,7 @@ pub struct MipArgs {
     #[arg(long, value_enum, default_value = "auto")]
     color: ColorArg,
 
-    /// Alpha convention of the input: auto, straight or premultiplied.
+    /// Alpha convention of the input: auto, straight, premultiplied or none.
     #[arg(
         long,
         value_enum,
@@ -111,7 +113,9 @@ pub struct MipArgs {
         value_name = "MODE",
         long_help = "Alpha convention of the input. auto: premultiplied (associated) for OpenEXR, \
         as the format defines it, straight for everything else. Straight alpha is filtered with \
-        alpha weighting; EXR outputs are always written premultiplied, as OpenEXR readers expect."
+        alpha weighting; EXR outputs are always written premultiplied, as OpenEXR readers expect. \
+        none: the second of two or fourth of four channels is data (a flow map, a packed mask), \
+        filtered like the others and never written as alpha."
     )]
     alpha: AlphaArg,
 
@@ -491,11 +495,13 @@ fn output_format(src: Format, kind: OutputKind, args: &MipArgs) -> anyhow::Resul
     } else {
         src.color_space
     };
-    let alpha = if kind == OutputKind::Exr && src.has_alpha() {
-        // OpenEXR defines colour as associated with alpha.
-        AlphaMode::Premultiplied
-    } else {
-        src.alpha
+    // Each container's alpha convention: OpenEXR defines colour as
+    // associated with alpha, PNG as unassociated; KTX2 and DDS say which in
+    // their headers, so they keep the source's.
+    let alpha = match kind {
+        OutputKind::Exr if src.has_alpha() => AlphaMode::Premultiplied,
+        OutputKind::PngLevels if src.has_alpha() => AlphaMode::Straight,
+        _ => src.alpha,
     };
     let f = Format::new(src.channels, ty, cs).with_alpha(alpha);
     Ok(match kind {
@@ -546,6 +552,7 @@ fn process(
         AlphaArg::Auto => src.alpha,
         AlphaArg::Straight => AlphaMode::Straight,
         AlphaArg::Premultiplied => AlphaMode::Premultiplied,
+        AlphaArg::None => AlphaMode::None,
     };
     base = base.reinterpret(src)?;
     let read_s = t_read.elapsed().as_secs_f64();
@@ -607,12 +614,11 @@ fn process(
     // Build in the source format when it is the output format, else in
     // linear f32 (see the module docs).
     let t_build = Instant::now();
-    let premultiply = out_format.has_alpha()
-        && src.alpha == AlphaMode::Straight
-        && out_format.alpha == AlphaMode::Premultiplied;
+    let association =
+        (out_format.has_alpha() && src.alpha != out_format.alpha).then_some(out_format.alpha);
     let same = src.channel_type == out_format.channel_type
         && src.color_space == out_format.color_space
-        && !premultiply;
+        && association.is_none();
     let work_base = if same {
         base
     } else {
@@ -645,7 +651,7 @@ fn process(
         .into_levels()
         .into_iter()
         .rev()
-        .map(|l| convert_level(l, out_format, premultiply))
+        .map(|l| convert_level(l, out_format, association))
         .collect::<anyhow::Result<_>>()?;
     levels.reverse();
     let build_s = t_build.elapsed().as_secs_f64();
@@ -694,24 +700,33 @@ fn auto_color(kind: FileFormat, f: Format) -> ColorSpace {
     }
 }
 
-/// Convert a built level to the output format (type, colour space, and
-/// channel widening for containers that need it).
-fn convert_level(mut l: Texture, out: Format, premultiply: bool) -> anyhow::Result<Texture> {
-    if premultiply {
-        // Built in linear f32 (see `process`): associate colour with alpha.
+/// Convert a built level to the output format (type, colour space, alpha
+/// association, and channel widening for containers that need it).
+fn convert_level(
+    mut l: Texture,
+    out: Format,
+    association: Option<AlphaMode>,
+) -> anyhow::Result<Texture> {
+    if let Some(to) = association {
+        // Built in linear f32 (see `process`).
         let ch = l.channels();
         let Texels::F32(v) = l.texels_mut() else {
-            anyhow::bail!("premultiplying needs f32 levels");
+            anyhow::bail!("changing the alpha association needs f32 levels");
         };
+        let premultiply = to == AlphaMode::Premultiplied;
         v.par_chunks_mut(ch * 4096).for_each(|rows| {
             for px in rows.chunks_exact_mut(ch) {
                 let a = px[ch - 1];
-                for c in &mut px[..ch - 1] {
-                    *c *= a;
+                if premultiply {
+                    px[..ch - 1].iter_mut().for_each(|c| *c *= a);
+                } else if a != 0.0 {
+                    // Where alpha is 0 the colour is kept, as oiiotool's
+                    // --unpremult does.
+                    px[..ch - 1].iter_mut().for_each(|c| *c /= a);
                 }
             }
         });
-        let f = l.format().with_alpha(AlphaMode::Premultiplied);
+        let f = l.format().with_alpha(to);
         l = l.reinterpret(f)?;
     }
     let narrow = Format {

@@ -30,9 +30,13 @@ pub fn level_path(template: &Path, k: usize) -> PathBuf {
     )
 }
 
-/// Encode one texture as PNG into `out`.
+/// Encode one texture as PNG into `out`. PNG's two-channel layout is grey +
+/// alpha, so R, G data (no alpha) is written as RGB with B = 0.
 pub fn write_png(t: &Texture, out: &mut impl std::io::Write) -> Result<()> {
     use ExtendedColorType::*;
+    if t.channels() == 2 && !t.format().has_alpha() {
+        return write_png(&super::expand_channels(t, 3)?, out);
+    }
     let (bytes, color): (&[u8], _) = match t.texels() {
         Texels::U8(v) => (v.as_slice(), [L8, La8, Rgb8, Rgba8][t.channels() - 1]),
         Texels::U16(v) => (

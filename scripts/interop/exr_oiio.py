@@ -4,31 +4,17 @@ maketx, Python bindings). Called by .ci/interop.sh with the venv's python;
 prints one line per check ("ok: ..." / "FAIL: ...") and exits 1 on any
 failure.
 
-Usage: interop_check.py PARVO_BIN VENV_BIN WORKDIR
+Usage: exr_oiio.py PARVO_BIN VENV_BIN WORKDIR
 """
+import json
 import re
-import subprocess
-import sys
 
 import numpy as np
 import OpenImageIO as oiio
 
-parvo, venv_bin, work = sys.argv[1], sys.argv[2], sys.argv[3]
-failures = 0
+from common import args, check, finish, oiio_levels, run
 
-
-def check(ok, what, detail=""):
-    global failures
-    print(("ok:   " if ok else "FAIL: ") + what + (f" ({detail})" if detail else ""), flush=True)
-    if not ok:
-        failures += 1
-
-
-def run(*cmd):
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        print(f"       command failed ({r.returncode}): {' '.join(cmd)}\n{r.stdout}{r.stderr}")
-    return r
+parvo, venv_bin, work = args()
 
 
 # A power-of-two, non-square float RGBA image of fixed-seed noise, written
@@ -68,20 +54,7 @@ check('wrapmodes: "clamp,clamp"' in info, "oiiotool sees wrapmodes clamp,clamp")
 check('textureformat: "Plain Texture"' in info, 'oiiotool sees textureformat "Plain Texture"')
 
 
-def levels(path):
-    inp = oiio.ImageInput.open(path)
-    if inp is None:
-        return []
-    res = []
-    level = 0
-    while inp.seek_subimage(0, level):
-        res.append(inp.read_image(0, level, 0, 4, "float"))
-        level += 1
-    inp.close()
-    return res
-
-
-a, b = levels(ours), levels(theirs)
+a, b = oiio_levels(ours)[0] or [], oiio_levels(theirs)[0] or []
 check(len(a) == len(want_levels) and len(b) == len(want_levels),
       "both files have the full chain", f"parvo {len(a)}, maketx {len(b)}, expected {len(want_levels)}")
 check(len(a) > 0 and np.array_equal(a[0], pixels), "parvo level 0 equals the source exactly")
@@ -100,7 +73,6 @@ print(f"       worst level difference parvo vs maketx: {worst:.3g}")
 r = run(parvo, "info", "--json", theirs)
 ok = r.returncode == 0
 if ok:
-    import json
     j = json.loads(r.stdout)
     n = len(j["levels"])
     ok = n == len(want_levels) and [f'{l["width"]}x{l["height"]}' for l in j["levels"]] == want_levels
@@ -113,4 +85,4 @@ else:
 r = run(parvo, "mip", theirs, "-o", f"{work}/roundtrip.exr", "--type", "f32")
 check(r.returncode == 0, "parvo mip accepts maketx's EXR as input")
 
-sys.exit(1 if failures else 0)
+finish()
