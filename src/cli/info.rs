@@ -59,6 +59,14 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
             Err(e) => {
                 failed = true;
                 eprintln!("parvo: {file}: {e}");
+                if args.json {
+                    // One object per file, failed ones included (as `mip
+                    // --json` does), so a script sees every file.
+                    println!(
+                        "{}",
+                        serde_json::json!({"file": file, "status": "failed", "error": e.to_string()})
+                    );
+                }
             }
         }
     }
@@ -148,6 +156,7 @@ fn json(file: &str, l: &Loaded) -> String {
     let i = &l.info;
     serde_json::json!({
         "file": file,
+        "status": "ok",
         "format": i.format.name(),
         "width": b.width(),
         "height": b.height(),

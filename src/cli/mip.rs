@@ -155,7 +155,14 @@ pub struct MipArgs {
     levels: Option<u32>,
 
     /// Level size rounding: down (floor, the GPU rule) or up.
-    #[arg(long, default_value = "down", value_name = "MODE")]
+    #[arg(
+        long,
+        default_value = "down",
+        value_name = "MODE",
+        long_help = "Level size rounding: down (floor(size / 2^k), the GPU rule) or up (ceil; \
+        OpenEXR's ROUND_UP). KTX2 and DDS define their level sizes by rounding down, so `up` is \
+        refused for them before any work (exit 2)."
+    )]
     rounding: Rounding,
 
     /// EXR compression: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab.
@@ -331,6 +338,33 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
         }
         _ => return usage("give -o OUTPUT (one input) or --out-dir DIR (a batch)".into()),
     };
+    // A channel type the container cannot store is a usage error, found
+    // before any input is read.
+    if let Some(t) = args.out_type
+        && let Some(j) = jobs.iter().find(|j| !j.kind.supports(t))
+    {
+        return usage(format!(
+            "--type {t}: {} cannot store {t} texels (EXR: f16, f32; PNG: u8, u16; KTX2 and DDS: all)",
+            j.kind.name()
+        ));
+    }
+    // Containers whose level sizes are fixed by their specification.
+    if args.rounding == Rounding::Up
+        && let Some(j) = jobs
+            .iter()
+            .find(|j| matches!(j.kind, OutputKind::Ktx2 | OutputKind::Dds))
+    {
+        return usage(format!(
+            "--rounding up: {} defines its level sizes as floor(size / 2^k); \
+             use .exr or PNG levels for rounded-up chains (output {})",
+            if j.kind == OutputKind::Ktx2 {
+                "KTX2"
+            } else {
+                "DDS"
+            },
+            j.output.display()
+        ));
+    }
     // Report panics (bugs in parvo or a dependency) as per-file errors, not
     // as the default multi-line message.
     std::panic::set_hook(Box::new(|_| {}));
@@ -480,12 +514,7 @@ fn output_format(src: Format, kind: OutputKind, args: &MipArgs) -> anyhow::Resul
     if !kind.supports(ty) {
         anyhow::bail!(
             "{} cannot store {ty} texels (EXR: f16, f32; PNG: u8, u16)",
-            match kind {
-                OutputKind::Exr => "OpenEXR",
-                OutputKind::PngLevels => "PNG",
-                OutputKind::Ktx2 => "KTX2",
-                OutputKind::Dds => "DDS",
-            }
+            kind.name()
         );
     }
     // Floats are linear light; integer outputs keep the source's encoding
@@ -549,6 +578,8 @@ fn process(
         (ColorArg::Auto, false) => auto_color(src_kind, src),
     };
     src.alpha = match args.alpha {
+        // A normal map's fourth channel is data, not alpha.
+        _ if args.normal_map => AlphaMode::None,
         AlphaArg::Auto => src.alpha,
         AlphaArg::Straight => AlphaMode::Straight,
         AlphaArg::Premultiplied => AlphaMode::Premultiplied,
@@ -611,27 +642,7 @@ fn process(
         });
     }
 
-    // Build in the source format when it is the output format, else in
-    // linear f32 (see the module docs).
     let t_build = Instant::now();
-    let association =
-        (out_format.has_alpha() && src.alpha != out_format.alpha).then_some(out_format.alpha);
-    let same = src.channel_type == out_format.channel_type
-        && src.color_space == out_format.color_space
-        && association.is_none();
-    let work_base = if same {
-        base
-    } else {
-        // Decode straight into the f32 buffer (`Texture::convert` would
-        // hold a second full-size f32 copy while encoding).
-        let f =
-            Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
-        let mut linear = vec![0f32; base.texels().len()];
-        parvo::texel::decode_to_linear(&base.format(), base.texels(), &mut linear);
-        let (w, h) = (base.width(), base.height());
-        drop(base);
-        Texture::from_f32(w, h, f, linear)?
-    };
     if let Some(b) = bar {
         let total: u64 = level_sizes[1..]
             .iter()
@@ -640,20 +651,31 @@ fn process(
         b.set_length(total.max(1));
         b.set_message(job.input.clone());
     }
-    let chain: MipChain = mip::build_with_progress(work_base, &options, &mut |p| {
+    let mut on_progress = |p: mip::Progress| {
         if let Some(b) = bar {
             b.set_position(p.texels_done);
         }
-    })?;
-    // Smallest level first, so level 0's f32 and converted copies never
-    // coexist with the unconverted rest of the chain.
-    let mut levels: Vec<Texture> = chain
-        .into_levels()
-        .into_iter()
-        .rev()
-        .map(|l| convert_level(l, out_format, association))
-        .collect::<anyhow::Result<_>>()?;
-    levels.reverse();
+    };
+    let association =
+        (out_format.has_alpha() && src.alpha != out_format.alpha).then_some(out_format.alpha);
+    let same = src.channel_type == out_format.channel_type
+        && src.color_space == out_format.color_space
+        && association.is_none();
+    let levels = if args.normal_map {
+        // Decoded to vectors, averaged in f32, encoded once per level into
+        // the output type (parvo::mip::normal).
+        mip::normal::build(base, &options, out_format, &mut on_progress)?
+    } else {
+        build_colour(
+            base,
+            &options,
+            src,
+            out_format,
+            association,
+            same,
+            &mut on_progress,
+        )?
+    };
     let build_s = t_build.elapsed().as_secs_f64();
     if let Some(b) = bar {
         b.set_message(format!("{}: writing {}", job.input, job.output.display()));
@@ -685,6 +707,44 @@ fn process(
         build_s,
         write_s,
     })
+}
+
+/// The colour chain: built in the source format when it is the output
+/// format, else in linear f32 from a single decode of level 0 (see the
+/// module docs), each level converted to the output format.
+fn build_colour(
+    base: Texture,
+    options: &MipOptions,
+    src: Format,
+    out_format: Format,
+    association: Option<AlphaMode>,
+    same: bool,
+    progress: &mut dyn FnMut(mip::Progress),
+) -> anyhow::Result<Vec<Texture>> {
+    let work_base = if same {
+        base
+    } else {
+        // Decode straight into the f32 buffer (`Texture::convert` would
+        // hold a second full-size f32 copy while encoding).
+        let f =
+            Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
+        let mut linear = vec![0f32; base.texels().len()];
+        parvo::texel::decode_to_linear(&base.format(), base.texels(), &mut linear);
+        let (w, h) = (base.width(), base.height());
+        drop(base);
+        Texture::from_f32(w, h, f, linear)?
+    };
+    let chain: MipChain = mip::build_with_progress(work_base, options, progress)?;
+    // Smallest level first, so level 0's f32 and converted copies never
+    // coexist with the unconverted rest of the chain.
+    let mut levels: Vec<Texture> = chain
+        .into_levels()
+        .into_iter()
+        .rev()
+        .map(|l| convert_level(l, out_format, association))
+        .collect::<anyhow::Result<_>>()?;
+    levels.reverse();
+    Ok(levels)
 }
 
 /// `--color auto`: sRGB for 8-bit PNG and JPEG (what the loader already

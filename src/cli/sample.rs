@@ -60,7 +60,13 @@ pub struct SampleArgs {
     #[arg(long, value_name = "L", allow_negative_numbers = true)]
     lod_max: Option<f32>,
     /// Wrap mode(s): repeat, mirror, clamp, border (black), mirror-clamp; MODE,MODE for u,v.
-    #[arg(long, value_name = "MODE[,MODE]")]
+    #[arg(
+        long,
+        value_name = "MODE[,MODE]",
+        long_help = "Wrap modes: repeat, mirror, clamp, border (black), mirror-clamp; MODE,MODE for u \
+        and v. Default: the modes the file records (EXR and TIFF `wrapmodes` as maketx writes them, \
+        parvo's KTX2 key), else repeat."
+    )]
     wrap: Option<Wrap>,
     /// Border colour for `border` wrapping, linear RGBA.
     #[arg(long, value_name = "R,G,B,A", value_parser = parse_border, allow_hyphen_values = true)]
@@ -133,12 +139,18 @@ fn load_chain(spec: &str) -> Result<MipChain> {
 }
 
 pub fn run(args: SampleArgs) -> Result<ExitCode> {
-    let options = args.options();
+    let mut options = args.options();
     if let Err(e) = options.validate() {
         eprintln!("parvo: {e}");
         return Ok(ExitCode::from(2));
     }
     let chain = load_chain(&args.texture)?;
+    if args.wrap.is_none() {
+        // The wrap modes the file records (EXR/TIFF `wrapmodes`, parvo's
+        // KTX2 key), as OpenImageIO's texture system uses them; repeat when
+        // it records none.
+        options.wrap = chain.options().wrap;
+    }
     let sampler = Sampler::new(&chain, options)?;
     drop(chain);
     let stdin = io::stdin().lock();

@@ -410,6 +410,16 @@ impl OutputKind {
         }
     }
 
+    /// Display name of the container ("OpenEXR", "PNG", ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            OutputKind::Exr => "OpenEXR",
+            OutputKind::Ktx2 => "KTX2",
+            OutputKind::Dds => "DDS",
+            OutputKind::PngLevels => "PNG",
+        }
+    }
+
     /// Channel types the container can store.
     pub fn supports(self, ty: ChannelType) -> bool {
         match self {

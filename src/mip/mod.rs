@@ -14,7 +14,8 @@
 //!      size and wrap mode. It is the reference the fast paths are tested
 //!      against (`tests/mip_fast_paths_match_plain.rs`).
 //! 3. Optional per-level post-processing: alpha-test coverage preservation
-//!    ([`alpha`]) and normal renormalisation ([`normal`]).
+//!    ([`alpha`]). Normal maps take their own path ([`normal`]): decoded to
+//!    unit vectors, averaged in f32, renormalised and encoded once per level.
 //!
 //! Memory: the general path decodes the source level to f32 once
 //! (4 bytes × channels × texels) unless it is already linear f32; the fast
@@ -155,8 +156,9 @@ pub struct MipOptions {
     /// Alpha-test coverage preservation with this reference alpha
     /// (Castaño); `None` (default) leaves alpha as filtered.
     pub alpha_coverage: Option<f32>,
-    /// Treat RGB as a unit normal (unorm: `2v − 1`) and renormalise every
-    /// level after filtering. Default: false.
+    /// Treat RGB as a unit normal (unorm codes `c` hold `2c − 1`, floats
+    /// the components) and build the chain from unit vectors, renormalising
+    /// each level once in full precision ([`normal`]). Default: false.
     pub normal_map: bool,
     /// What to do with NaN/Inf in float input. Default: error.
     pub nan_policy: NanPolicy,
@@ -313,6 +315,13 @@ impl MipChain {
 /// [`NanPolicy::Error`] need to modify level 0 and are refused here.
 pub fn build_reduced_levels(base: &Texture, options: &MipOptions) -> Result<Vec<Texture>> {
     validate(base, options)?;
+    if options.normal_map {
+        let vectors = normal::build_levels(base, options, &mut |_| {})?;
+        return vectors[1..]
+            .iter()
+            .map(|v| normal::encode(v, base.format()))
+            .collect();
+    }
     if options.nan_policy != NanPolicy::Error {
         return Err(Error::InvalidOption(
             "build_reduced_levels cannot repair level 0: use build with this NaN policy".into(),
@@ -356,9 +365,6 @@ fn reduce_post(
     if let (Some(r), Some(c0)) = (options.alpha_coverage, coverage0) {
         alpha::preserve_coverage(&mut next, r, c0);
     }
-    if options.normal_map {
-        normal::renormalize(&mut next);
-    }
     Ok((next, finite))
 }
 
@@ -375,6 +381,14 @@ pub fn build_with_progress(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<MipChain> {
     validate(&base, options)?;
+    if options.normal_map {
+        let f = base.format();
+        let levels = normal::build(base, options, f, progress)?;
+        return Ok(MipChain {
+            levels,
+            options: *options,
+        });
+    }
     let deferred = defer_nan_check(&base, options)?;
     if !deferred {
         nan::apply(&mut base, options.nan_policy)?;
@@ -445,22 +459,13 @@ fn validate(base: &Texture, options: &MipOptions) -> Result<()> {
                 "alpha coverage reference {r} must be between 0 and 1 (exclusive)"
             )));
         }
-        if !base.format().has_alpha() {
+        if !base.format().has_alpha() && !options.normal_map {
             return Err(Error::InvalidOption(
                 "alpha coverage needs a texture with an alpha channel".into(),
             ));
         }
     }
-    if options.normal_map && base.channels() < 3 {
-        return Err(Error::InvalidOption(
-            "a normal map needs at least 3 channels".into(),
-        ));
-    }
-    if options.normal_map && base.format().color_space == crate::texel::ColorSpace::Srgb {
-        return Err(Error::InvalidOption(
-            "normal maps hold vectors, not colours: load them as linear".into(),
-        ));
-    }
+
     if options.max_levels == Some(0) {
         return Err(Error::InvalidOption(
             "the chain needs at least one level".into(),

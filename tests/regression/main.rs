@@ -2,4 +2,11 @@
 //! finding (an issue's defect or a fuzzer's crash), each with the file or
 //! input that showed it, made in the test.
 
+mod util;
+
 mod dds_headers_pillow_read_as_black;
+mod info_json_silent_on_failure;
+mod normal_maps_filtered_as_encoded_codes;
+mod premultiplied_exr_written_premultiplied_to_png;
+mod rounding_up_writes_invalid_ktx2;
+mod sample_ignores_recorded_wrap_modes;
