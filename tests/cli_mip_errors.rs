@@ -286,11 +286,13 @@ fn usage_errors_exit_2() {
 }
 
 #[test]
-fn impossible_type_for_the_container_is_a_per_file_error() {
+fn impossible_type_is_a_usage_error_and_a_short_exr_chain_a_per_file_error() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.exr");
+    // Known from the arguments alone: exit 2 before any input is read.
     let o = parvo(&["mip", "builtin:checker:8", "-o", s(&out), "--type", "u8"]);
-    assert_one_line_error(&o, "builtin:checker:8", "cannot store u8");
+    assert_eq!(o.status.code(), Some(2), "{o:?}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot store u8"));
     let o = parvo(&["mip", "builtin:checker:8", "-o", s(&out), "--levels", "2"]);
     assert_one_line_error(&o, "builtin:checker:8", "full chain");
 }

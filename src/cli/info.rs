@@ -141,6 +141,9 @@ fn text(file: &str, l: &Loaded) -> String {
             .map(|w| format!("{},{}", w.u.oiio_name(), w.v.oiio_name()))
             .unwrap_or_else(|| "(not recorded)".into())
     );
+    for n in &i.notes {
+        let _ = writeln!(s, "  note:       {n}");
+    }
     if !i.attributes.is_empty() {
         let _ = writeln!(s, "  metadata:");
         for (k, v) in &i.attributes {
@@ -174,6 +177,7 @@ fn json(file: &str, l: &Loaded) -> String {
         })).collect::<Vec<_>>(),
         "wrapmodes": i.wrap.map(|w| format!("{},{}", w.u.oiio_name(), w.v.oiio_name())),
         "attributes": i.attributes.iter().cloned().collect::<std::collections::BTreeMap<_, _>>(),
+        "notes": i.notes,
     })
     .to_string()
 }

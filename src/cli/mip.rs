@@ -209,6 +209,28 @@ pub struct MipArgs {
     /// Largest decoded size of an input, e.g. 4G, 512M, 1000000.
     #[arg(long, default_value = "4G", value_name = "BYTES", value_parser = parse_bytes)]
     max_alloc: u64,
+
+    /// EXR channels to load, in order: e.g. N.X,N.Y,N.Z or diffuse.R,diffuse.G,diffuse.B,diffuse.A.
+    #[arg(
+        long,
+        value_name = "NAMES",
+        value_delimiter = ',',
+        long_help = "OpenEXR channels to load, by full name in the order wanted (1 to 4), e.g. \
+        N.X,N.Y,N.Z or diffuse.R,diffuse.G,diffuse.B,diffuse.A. Default: OpenImageIO's conventions: \
+        every channel when there are at most four (ordered by layer, then R, G, B, Y, A, ...; \
+        X, Y, Z in a layer that has them), else the first layer's R,G,B[,A] or Y[,A]. A channel is \
+        alpha only when it is named A (or Alpha) and is the last of two or four; other names are \
+        data channels. The names are kept on EXR output."
+    )]
+    channels: Option<Vec<String>>,
+
+    /// Which part of a multi-part EXR or page of a multi-page TIFF to read (0 = the first).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    subimage: usize,
+
+    /// Keep JPEG/TIFF pixels in stored order instead of applying the EXIF orientation.
+    #[arg(long)]
+    no_auto_orient: bool,
 }
 
 fn parse_tile(s: &str) -> Result<(u32, u32), String> {
@@ -275,6 +297,8 @@ struct Outcome {
     read_s: f64,
     build_s: f64,
     write_s: f64,
+    /// What the loader did that the user would not assume, for stderr.
+    notes: Vec<String>,
 }
 
 /// One job: an input and where it goes.
@@ -430,6 +454,12 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
         };
         match result {
             Ok(o) => {
+                for n in &o.notes {
+                    match &bar {
+                        Some(b) => b.suspend(|| eprintln!("parvo: {}: {n}", job.input)),
+                        None => eprintln!("parvo: {}: {n}", job.input),
+                    }
+                }
                 if args.json {
                     line(json_line(job, &o, t0.elapsed().as_secs_f64()));
                 } else {
@@ -566,9 +596,16 @@ fn process(
     bar: Option<&ProgressBar>,
 ) -> anyhow::Result<Outcome> {
     let t_read = Instant::now();
-    let loaded = io::load(&job.input, limits)?;
+    let load_options = io::LoadOptions {
+        channels: args.channels.clone(),
+        subimage: args.subimage,
+        auto_orient: !args.no_auto_orient,
+    };
+    let loaded = io::load_with(&job.input, limits, &load_options)?;
     let src_kind = loaded.info.format;
     let file_wrap = loaded.info.wrap;
+    let notes = loaded.info.notes.clone();
+    let channel_names = loaded.info.channel_names.clone();
     let mut base = loaded.into_base();
     // Interpretation of the input.
     let mut src = base.format();
@@ -624,6 +661,7 @@ fn process(
             read_s,
             build_s: 0.0,
             write_s: 0.0,
+            notes: notes.clone(),
         });
     }
     if args.update
@@ -639,6 +677,7 @@ fn process(
             read_s,
             build_s: 0.0,
             write_s: 0.0,
+            notes: notes.clone(),
         });
     }
 
@@ -683,6 +722,11 @@ fn process(
 
     let t_write = Instant::now();
     let save = SaveOptions {
+        // An EXR source's channel names carry to EXR output (N.X stays
+        // N.X, a lone Z stays Z); other sources get the layout's names.
+        channel_names: (src_kind == FileFormat::Exr
+            && channel_names.len() == out_format.channels as usize)
+            .then_some(channel_names),
         wrap: options.wrap,
         tile: args.tile,
         compression: args.compression,
@@ -706,6 +750,7 @@ fn process(
         read_s,
         build_s,
         write_s,
+        notes,
     })
 }
 
@@ -887,6 +932,7 @@ fn json_line(job: &Job, o: &Outcome, secs: f64) -> String {
             "write": o.write_s,
         },
         "peak_rss_bytes": peak_rss_bytes(),
+        "notes": o.notes,
     })
     .to_string()
 }

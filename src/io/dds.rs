@@ -1023,7 +1023,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     }
     let base = &levels[0];
     let format = base.format();
-    let mut info = SourceInfo::new(FileFormat::Dds, format.channels);
+    let mut info = SourceInfo::new(FileFormat::Dds, &format);
     info.own_mips = levels.len() > 1;
     info.channel_names = match (format.channels, format.has_alpha()) {
         (1, _) => vec!["R".into()],

@@ -205,7 +205,25 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
             "EXR holds linear data; convert sRGB texels first",
         ));
     }
-    let names = super::layout_names(fmt.channels);
+    let names = match &opts.channel_names {
+        Some(n) => {
+            let mut sorted = n.clone();
+            sorted.sort();
+            sorted.dedup();
+            if n.len() != fmt.channels as usize
+                || sorted.len() != n.len()
+                || n.iter()
+                    .any(|c| c.is_empty() || Text::new_or_none(c.as_str()).is_none())
+            {
+                return Err(encode_err(format!(
+                    "channel names {n:?} do not name {} distinct channels",
+                    fmt.channels
+                )));
+            }
+            n.clone()
+        }
+        None => super::layout_names(&fmt),
+    };
     // Channels are stored sorted by name (A, B, G, R).
     let mut order: Vec<usize> = (0..names.len()).collect();
     order.sort_by(|&a, &b| names[a].cmp(&names[b]));
@@ -264,7 +282,7 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
     let tile = (tw as usize, th as usize);
     atomic::write(path, |out| {
         ::exr::block::write(
-            out,
+            &mut *out,
             std::iter::once(header).collect(),
             true,
             |meta, writer| {
@@ -307,8 +325,68 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
                 Ok(())
             },
         )
-        .map_err(encode_err)
+        .map_err(encode_err)?;
+        // The exr crate writes custom attributes in hash-map order, which
+        // changes from run to run; sort them in place so that the same
+        // input and options give the same bytes.
+        std::io::Write::flush(out).map_err(encode_err)?;
+        sort_header_attributes(out.get_ref()).map_err(encode_err)
     })
+}
+
+/// Rewrite the attributes of a single-part EXR header in name order, in
+/// place: the same attributes in another order take the same bytes, so
+/// the offset table and the pixels after them stay where they are.
+fn sort_header_attributes(mut file: &std::fs::File) -> std::io::Result<()> {
+    use std::io::{Read, Seek, SeekFrom, Write};
+    let bad = |m: &str| std::io::Error::new(std::io::ErrorKind::InvalidData, m.to_string());
+    file.seek(SeekFrom::Start(0))?;
+    // Magic and version (8 bytes), then the attributes; headers of files
+    // parvo writes are small, a few KiB cover them.
+    let mut head = Vec::new();
+    file.take(1 << 20).read_to_end(&mut head)?;
+    let mut at = 8usize;
+    let mut attrs: Vec<(Vec<u8>, std::ops::Range<usize>)> = Vec::new();
+    let cstr = |b: &[u8], from: usize| -> std::io::Result<usize> {
+        b[from..]
+            .iter()
+            .position(|&c| c == 0)
+            .map(|p| from + p)
+            .ok_or_else(|| bad("EXR header: unterminated name"))
+    };
+    loop {
+        if at >= head.len() {
+            return Err(bad("EXR header: no end"));
+        }
+        if head[at] == 0 {
+            break;
+        }
+        let name_end = cstr(&head, at)?;
+        let type_end = cstr(&head, name_end + 1)?;
+        let size_at = type_end + 1;
+        let size = head
+            .get(size_at..size_at + 4)
+            .map(|b| i32::from_le_bytes(b.try_into().expect("4 bytes")))
+            .ok_or_else(|| bad("EXR header: truncated attribute"))?;
+        let end =
+            size_at + 4 + usize::try_from(size).map_err(|_| bad("EXR header: negative size"))?;
+        if end > head.len() {
+            return Err(bad("EXR header: attribute past the end"));
+        }
+        attrs.push((head[at..name_end].to_vec(), at..end));
+        at = end;
+    }
+    let mut sorted = attrs.clone();
+    sorted.sort_by(|a, b| a.0.cmp(&b.0));
+    let bytes: Vec<u8> = sorted
+        .iter()
+        .flat_map(|(_, r)| head[r.clone()].iter().copied())
+        .collect();
+    debug_assert_eq!(bytes.len(), at - 8);
+    file.seek(SeekFrom::Start(8))?;
+    file.write_all(&bytes)?;
+    file.seek(SeekFrom::End(0))?;
+    Ok(())
 }
 
 /// The uncompressed bytes of one tile: for each line, for each channel in
@@ -427,15 +505,184 @@ fn attribute_text(v: &AttributeValue) -> String {
     }
 }
 
-/// Load an EXR file: the first part, all its mip levels.
-pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
+/// OpenImageIO's order of channel suffixes within a layer (its
+/// `ChanNameHolder::compute_special_index`); a layer holding `X` and `Y` or
+/// `Z` uses the second list, so positions and normals keep X, Y, Z order.
+const SPECIAL: [&str; 20] = [
+    "R", "Red", "G", "Green", "B", "Blue", "Y", "real", "imag", "A", "Alpha", "AR", "RA", "AG",
+    "GA", "AB", "BA", "Z", "Depth", "Zback",
+];
+const SPECIAL_XYZ: [&str; 21] = [
+    "R", "Red", "G", "Green", "B", "Blue", "X", "Y", "Z", "real", "imag", "A", "Alpha", "AR", "RA",
+    "AG", "GA", "AB", "BA", "Depth", "Zback",
+];
+
+/// `diffuse.R` → (`diffuse`, `R`); `R` → (``, `R`).
+fn split_name(n: &str) -> (&str, &str) {
+    match n.rfind('.') {
+        Some(i) => (&n[..i], &n[i + 1..]),
+        None => ("", n),
+    }
+}
+
+fn is_alpha_name(n: &str) -> bool {
+    let s = split_name(n).1;
+    s.eq_ignore_ascii_case("A") || s.eq_ignore_ascii_case("Alpha")
+}
+
+/// Channel indices in the order OpenImageIO presents them: by layer, then
+/// by the special-name order, then by name.
+fn oiio_order(names: &[String]) -> Vec<usize> {
+    let has = |layer: &str, suffix: &str| {
+        names.iter().any(|n| {
+            let (l, s) = split_name(n);
+            l == layer && s.eq_ignore_ascii_case(suffix)
+        })
+    };
+    let key = |i: usize| {
+        let (layer, suffix) = split_name(&names[i]);
+        let xyz = has(layer, "X") && (has(layer, "Y") || has(layer, "Z"));
+        let list: &[&str] = if xyz { &SPECIAL_XYZ } else { &SPECIAL };
+        let special = list
+            .iter()
+            .position(|s| s.eq_ignore_ascii_case(suffix))
+            .unwrap_or(10_000);
+        (layer.to_string(), special, suffix.to_string())
+    };
+    let mut order: Vec<usize> = (0..names.len()).collect();
+    order.sort_by_key(|&i| key(i));
+    order
+}
+
+/// Which channels to load, and whether the last is alpha: `requested`
+/// names (full names, in the order given), or by OpenImageIO's
+/// conventions: every channel when there are at most four, else the first
+/// layer's `R,G,B[,A]` or `Y[,A]`. A channel is alpha only when it is
+/// named `A` (or `Alpha`) and is the last of two or four. Returns the
+/// indices, the alpha flag and a note when the mapping is not the obvious
+/// one.
+fn choose_channels(
+    names: &[String],
+    requested: Option<&[String]>,
+) -> Result<(Vec<usize>, bool, Option<String>)> {
+    let list = names.join(",");
+    let order: Vec<usize> = match requested {
+        Some(req) => {
+            if req.is_empty() || req.len() > 4 {
+                return Err(Error::InvalidOption(format!(
+                    "--channels takes 1 to 4 names, got {}",
+                    req.len()
+                )));
+            }
+            let mut v = Vec::new();
+            for r in req {
+                let i = names.iter().position(|n| n == r).ok_or_else(|| {
+                    Error::InvalidOption(format!(
+                        "--channels: no channel `{r}` (the file has {list})"
+                    ))
+                })?;
+                if v.contains(&i) {
+                    return Err(Error::InvalidOption(format!(
+                        "--channels: `{r}` given twice"
+                    )));
+                }
+                v.push(i);
+            }
+            v
+        }
+        None => {
+            let sorted = oiio_order(names);
+            if sorted.len() <= 4 {
+                sorted
+            } else {
+                let mut layers: Vec<&str> =
+                    sorted.iter().map(|&i| split_name(&names[i]).0).collect();
+                layers.dedup();
+                let find = |layer: &str, suffix: &str| {
+                    sorted.iter().copied().find(|&i| {
+                        let (l, s) = split_name(&names[i]);
+                        l == layer && s == suffix
+                    })
+                };
+                let pick = layers.iter().find_map(|&l| {
+                    let a = find(l, "A");
+                    match (find(l, "R"), find(l, "G"), find(l, "B"), find(l, "Y")) {
+                        (Some(r), Some(g), Some(b), _) => Some(
+                            [Some(r), Some(g), Some(b), a]
+                                .into_iter()
+                                .flatten()
+                                .collect(),
+                        ),
+                        (_, _, _, Some(y)) => Some([Some(y), a].into_iter().flatten().collect()),
+                        _ => None,
+                    }
+                });
+                pick.ok_or_else(|| {
+                    decode_err(format!(
+                        "{} channels ({list}) and no layer with R,G,B or Y: parvo reads 1 to 4 channels, pick them with --channels",
+                        names.len()
+                    ))
+                })?
+            }
+        }
+    };
+    let n = order.len();
+    let alpha = matches!(n, 2 | 4) && is_alpha_name(&names[order[n - 1]]);
+    let chosen: Vec<&str> = order.iter().map(|&i| names[i].as_str()).collect();
+    let suffixes: Vec<&str> = chosen.iter().map(|n| split_name(n).1).collect();
+    let obvious = matches!(
+        suffixes.as_slice(),
+        ["R", "G", "B"] | ["R", "G", "B", "A"] | ["Y"] | ["Y", "A"]
+    );
+    let mut note = None;
+    if !obvious || chosen.len() < names.len() {
+        let layout = match (n, alpha) {
+            (1, _) => "one channel".to_string(),
+            (2, true) => "grey + alpha".to_string(),
+            (3, _) => "R,G,B".to_string(),
+            (4, true) => "R,G,B + alpha".to_string(),
+            (k, false) => format!("{k} data channels, no alpha"),
+            _ => unreachable!("1 to 4 channels"),
+        };
+        let mut s = format!("channels {} read as {layout}", chosen.join(","));
+        if chosen.len() < names.len() {
+            s.push_str(&format!(" (the file has {list}; --channels picks others)"));
+        }
+        if !alpha && chosen.iter().any(|c| is_alpha_name(c)) {
+            s.push_str("; the A channel is not last of 2 or 4, so it is data");
+        }
+        note = Some(s);
+    }
+    Ok((order, alpha, note))
+}
+
+/// Load an EXR file: the first part (or `options.subimage`), all its mip
+/// levels, the channels [`choose_channels`] picks; a data window that is
+/// not the display window is placed in the display window, black outside
+/// (as maketx pads it), what lies outside is cropped, and a note says so.
+pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Result<Loaded> {
     let meta = MetaData::read_from_file(path, false).map_err(decode_err)?;
-    let header = meta
-        .headers
-        .first()
-        .ok_or_else(|| decode_err("no image part in the file"))?;
+    let parts = meta.headers.len();
+    let part = options.subimage;
+    let header = meta.headers.get(part).ok_or_else(|| {
+        Error::InvalidOption(format!(
+            "--subimage {part}: the file has {parts} part{}",
+            if parts == 1 { "" } else { "s" }
+        ))
+    })?;
     if header.deep {
         return Err(decode_err("deep data is not a texture"));
+    }
+    let mut notes = Vec::new();
+    if parts > 1 {
+        notes.push(format!(
+            "multi-part file: using part {part} ({}) of {parts}; --subimage N picks another",
+            header
+                .own_attributes
+                .layer_name
+                .as_ref()
+                .map_or_else(|| "unnamed".to_string(), |t| format!("`{t}`"))
+        ));
     }
     let (w, h) = (header.layer_size.width(), header.layer_size.height());
     let (sizes, tile, rounding, mipmapped) = match header.blocks {
@@ -458,13 +705,34 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
             }
         }
     };
+    let all_names: Vec<String> = header
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    let (order, alpha, note) = choose_channels(&all_names, options.channels.as_deref())?;
+    notes.extend(note);
     let channels = header.channels.list.len() as u64;
     let texels: u64 = sizes.iter().map(|&(a, b)| a as u64 * b as u64).sum();
-    // Decoded bytes: the exr crate's planes plus our interleaved copy.
+    // Decoded bytes: the exr crate's planes (of every part when another
+    // than the first is read) plus our interleaved copy.
+    let planes: u64 = if part == 0 {
+        texels.saturating_mul(channels).saturating_mul(4)
+    } else {
+        meta.headers
+            .iter()
+            .map(|h| {
+                (h.layer_size.area() as u64)
+                    .saturating_mul(h.channels.list.len() as u64)
+                    .saturating_mul(8)
+            })
+            .sum()
+    };
     limits.check(
         w as u64,
         h as u64,
-        texels.saturating_mul(channels).saturating_mul(8),
+        planes.saturating_add(texels.saturating_mul(order.len() as u64 * 4)),
     )?;
     let mut attributes: Vec<(String, String)> = Vec::new();
     for (k, v) in header
@@ -489,42 +757,72 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         }
     }
     attributes.push(("compression".into(), header.compression.to_string()));
+    let data_window = header.data_window();
+    let display = header.shared_attributes.display_window;
+    if data_window != display {
+        attributes.push((
+            "dataWindow".into(),
+            format!(
+                "({}, {}) {}x{}",
+                data_window.position.x(),
+                data_window.position.y(),
+                data_window.size.width(),
+                data_window.size.height()
+            ),
+        ));
+        attributes.push((
+            "displayWindow".into(),
+            format!(
+                "({}, {}) {}x{}",
+                display.position.x(),
+                display.position.y(),
+                display.size.width(),
+                display.size.height()
+            ),
+        ));
+    }
     attributes.sort();
     let wrap = attributes
         .iter()
         .find(|(k, _)| k == "wrapmodes")
         .and_then(|(_, v)| v.parse().ok());
 
-    let image = ::exr::prelude::read()
+    let reader = ::exr::prelude::read()
         .no_deep_data()
         .all_resolution_levels()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(decode_err)?;
-    let layer = image.layer_data;
-    let list = &layer.channel_data.list;
-    let all_names: Vec<String> = list.iter().map(|c| c.name.to_string()).collect();
-    let short = |n: &str| n.rsplit('.').next().unwrap_or(n).to_string();
-    let find = |want: &str| all_names.iter().position(|n| short(n) == want);
-    let order: Vec<usize> = match (find("R"), find("G"), find("B"), find("A"), find("Y")) {
-        (Some(r), Some(g), Some(b), a, _) => [Some(r), Some(g), Some(b), a]
-            .into_iter()
-            .flatten()
-            .collect(),
-        (_, _, _, a, Some(y)) => [Some(y), a].into_iter().flatten().collect(),
-        _ if (1..=4).contains(&list.len()) => (0..list.len()).collect(),
-        _ => {
-            return Err(decode_err(format!(
-                "channels {} do not form a texture (expected R,G,B[,A], Y[,A] or 1 to 4 channels)",
-                all_names.join(",")
-            )));
+        .all_channels();
+    let layer = if part == 0 {
+        reader
+            .first_valid_layer()
+            .all_attributes()
+            .from_file(path)
+            .map_err(decode_err)?
+            .layer_data
+    } else {
+        let mut layers = reader
+            .all_layers()
+            .all_attributes()
+            .from_file(path)
+            .map_err(decode_err)?
+            .layer_data;
+        if part >= layers.len() {
+            return Err(decode_err(format!("part {part} has no readable pixels")));
         }
+        layers.swap_remove(part)
     };
-    let half = order
+    let list = &layer.channel_data.list;
+    // The crate's channel list is sorted by name, as the header's is.
+    let by_name = |n: &str| list.iter().position(|c| c.name.to_string() == n);
+    let order: Vec<usize> = order
         .iter()
-        .all(|&i| header.channels.list[i].sample_type == SampleType::F16);
+        .map(|&i| by_name(&all_names[i]).ok_or_else(|| decode_err("channel list changed")))
+        .collect::<Result<_>>()?;
+    let half = order.iter().all(|&i| {
+        matches!(
+            list[i].sample_data.levels_as_slice()[0],
+            FlatSamples::F16(_)
+        )
+    });
     let per_channel: Vec<Vec<&FlatSamples>> = order
         .iter()
         .map(|&i| match &list[i].sample_data {
@@ -550,9 +848,11 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     };
     // OpenEXR stores colour associated with (premultiplied by) alpha.
     let mut format = Format::new(ch as u8, ty, ColorSpace::Linear);
-    if format.has_alpha() {
-        format = format.with_alpha(AlphaMode::Premultiplied);
-    }
+    format = format.with_alpha(if alpha {
+        AlphaMode::Premultiplied
+    } else {
+        AlphaMode::None
+    });
     let mut levels = Vec::with_capacity(nlev);
     for (k, &(lw, lh)) in sizes.iter().enumerate().take(nlev) {
         let n = lw * lh;
@@ -585,14 +885,83 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         };
         levels.push(Texture::from_texels(lw as u32, lh as u32, format, texels)?);
     }
+    if data_window != display {
+        let (placed, note) = place_in_display_window(&levels[0], data_window, display)?;
+        if levels.len() > 1 {
+            notes.push(format!(
+                "{note}; the file's own {} mip levels are dropped (they cover the data window) and rebuilt",
+                levels.len()
+            ));
+        } else {
+            notes.push(note);
+        }
+        levels = vec![placed];
+    }
     let info = SourceInfo {
         format: FileFormat::Exr,
         own_mips: levels.len() > 1,
         rounding,
         wrap,
         tile,
-        channel_names: order.iter().map(|&i| all_names[i].clone()).collect(),
+        channel_names: order.iter().map(|&i| list[i].name.to_string()).collect(),
         attributes,
+        notes,
     };
     Ok(Loaded { levels, info })
+}
+
+/// Level 0 placed in the display window: texels of the data window inside
+/// it copied at their offset, zero (transparent black) elsewhere.
+fn place_in_display_window(
+    t: &Texture,
+    data: ::exr::meta::attribute::IntegerBounds,
+    display: ::exr::meta::attribute::IntegerBounds,
+) -> Result<(Texture, String)> {
+    let (dw, dh) = (display.size.width() as u32, display.size.height() as u32);
+    let mut out = Texture::new(dw, dh, t.format())?;
+    let ch = t.channels();
+    let (ox, oy) = (
+        data.position.x() as i64 - display.position.x() as i64,
+        data.position.y() as i64 - display.position.y() as i64,
+    );
+    let (sw, sh) = (t.width() as i64, t.height() as i64);
+    let x0 = ox.max(0);
+    let x1 = (ox + sw).min(dw as i64);
+    let y0 = oy.max(0);
+    let y1 = (oy + sh).min(dh as i64);
+    let inside = (x1 - x0).max(0) * (y1 - y0).max(0);
+    fn copy<T: Copy>(src: &[T], dst: &mut [T], ch: usize, sw: i64, dw: i64, r: [i64; 6]) {
+        let [ox, oy, x0, x1, y0, y1] = r;
+        if x1 <= x0 {
+            return;
+        }
+        for y in y0..y1 {
+            let s = (((y - oy) * sw + (x0 - ox)) as usize) * ch;
+            let d = ((y * dw + x0) as usize) * ch;
+            let n = ((x1 - x0) as usize) * ch;
+            dst[d..d + n].copy_from_slice(&src[s..s + n]);
+        }
+    }
+    let r = [ox, oy, x0, x1, y0, y1];
+    match (t.texels(), out.texels_mut()) {
+        (Texels::F16(s), Texels::F16(d)) => copy(s, d, ch, sw, dw as i64, r),
+        (Texels::F32(s), Texels::F32(d)) => copy(s, d, ch, sw, dw as i64, r),
+        _ => return Err(decode_err("EXR levels are f16 or f32")),
+    }
+    let cropped = sw * sh - inside;
+    let mut note = format!(
+        "data window ({}, {}) {}x{} placed in the display window ({}, {}) {dw}x{dh}, black outside (as maketx pads it)",
+        data.position.x(),
+        data.position.y(),
+        sw,
+        sh,
+        display.position.x(),
+        display.position.y()
+    );
+    if cropped > 0 {
+        note.push_str(&format!(
+            "; {cropped} texels outside the display window are cropped"
+        ));
+    }
+    Ok((out, note))
 }

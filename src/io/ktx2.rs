@@ -353,11 +353,11 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         .iter()
         .find(|(k, _)| k == "parvo:wrapmodes")
         .and_then(|(_, v)| v.parse().ok());
-    let mut info = SourceInfo::new(FileFormat::Ktx2, format.channels);
+    let mut info = SourceInfo::new(FileFormat::Ktx2, &format);
     info.channel_names = match format.channels {
         1 => vec!["R".into()],
         2 => vec!["R".into(), "G".into()],
-        n => super::layout_names(n),
+        _ => super::layout_names(&format),
     };
     info.own_mips = levels.len() > 1;
     info.wrap = wrap;

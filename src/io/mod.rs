@@ -98,18 +98,24 @@ pub struct SourceInfo {
     pub channel_names: Vec<String>,
     /// Other metadata as name/value text, sorted by name.
     pub attributes: Vec<(String, String)>,
+    /// What the loader did that a user would not assume (channels mapped,
+    /// a part or page chosen among several, a data window placed, an
+    /// orientation applied), one sentence each; the CLI prints them on
+    /// stderr.
+    pub notes: Vec<String>,
 }
 
 impl SourceInfo {
-    fn new(format: FileFormat, channels: u8) -> Self {
+    fn new(format: FileFormat, texels: &Format) -> Self {
         SourceInfo {
             format,
             own_mips: false,
             rounding: Rounding::Down,
             wrap: None,
             tile: None,
-            channel_names: layout_names(channels),
+            channel_names: layout_names(texels),
             attributes: Vec::new(),
+            notes: Vec::new(),
         }
     }
 
@@ -122,12 +128,17 @@ impl SourceInfo {
     }
 }
 
-fn layout_names(channels: u8) -> Vec<String> {
-    let names: &[&str] = match channels {
-        1 => &["Y"],
-        2 => &["Y", "A"],
-        3 => &["R", "G", "B"],
-        _ => &["R", "G", "B", "A"],
+/// The channel names a texel format implies: `Y`, `Y,A` (grey + alpha),
+/// `R,G` (two data channels), `R,G,B`, `R,G,B,A`, and `R,G,B,W` when the
+/// fourth channel is data, not alpha.
+pub fn layout_names(format: &Format) -> Vec<String> {
+    let names: &[&str] = match (format.channels, format.has_alpha()) {
+        (1, _) => &["Y"],
+        (2, true) => &["Y", "A"],
+        (2, false) => &["R", "G"],
+        (3, _) => &["R", "G", "B"],
+        (_, true) => &["R", "G", "B", "A"],
+        (_, false) => &["R", "G", "B", "W"],
     };
     names.iter().map(|s| s.to_string()).collect()
 }
@@ -154,13 +165,42 @@ impl Loaded {
     }
 }
 
+/// Choices a loader cannot make from the file alone.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// The channels to load, by name in the order wanted (OpenEXR); `None`
+    /// follows OpenImageIO's conventions (see [`exr::load`]).
+    pub channels: Option<Vec<String>>,
+    /// Which part of a multi-part EXR or page of a multi-page TIFF (0, the
+    /// default, is the first).
+    pub subimage: usize,
+    /// Rotate JPEG and TIFF images by their EXIF orientation, as image
+    /// viewers and `oiiotool --autoorient` do. Default: true.
+    pub auto_orient: bool,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            channels: None,
+            subimage: 0,
+            auto_orient: true,
+        }
+    }
+}
+
 /// Load a texture file or a `builtin:` name (see the module docs).
 pub fn load(spec: &str, limits: &Limits) -> Result<Loaded> {
+    load_with(spec, limits, &LoadOptions::default())
+}
+
+/// [`load`] with [`LoadOptions`].
+pub fn load_with(spec: &str, limits: &Limits, options: &LoadOptions) -> Result<Loaded> {
     if crate::builtin::is_builtin(spec) {
         let (kind, size) = crate::builtin::parse(spec)?;
         limits.check(size as u64, size as u64, size as u64 * size as u64 * 4)?;
         let t = crate::builtin::generate(kind, size)?;
-        let info = SourceInfo::new(FileFormat::Builtin, t.format().channels);
+        let info = SourceInfo::new(FileFormat::Builtin, &t.format());
         return Ok(Loaded {
             levels: vec![t],
             info,
@@ -206,8 +246,13 @@ pub fn load(spec: &str, limits: &Limits) -> Result<Loaded> {
     // The decoders are dependencies; a panic in one on a malformed file
     // becomes a decode error, never a crash of the caller.
     std::panic::catch_unwind(|| {
+        if options.channels.is_some() && !magic.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            return Err(Error::InvalidOption(
+                "--channels selects channels of OpenEXR files; this input is not one".into(),
+            ));
+        }
         if magic.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-            exr::load(path, limits)
+            exr::load(path, limits, options)
         } else if magic.starts_with(ktx2::IDENTIFIER.as_slice()) {
             ktx2::load(path, limits)
         } else if magic.starts_with(b"DDS ") {
@@ -300,7 +345,7 @@ fn load_image(path: &Path, limits: &Limits) -> Result<Loaded> {
         DynamicImage::ImageRgb32F(b) => Texture::from_f32(w, h, f(3, F32), b.into_raw()),
         other => Texture::from_f32(w, h, f(4, F32), other.into_rgba32f().into_raw()),
     }?;
-    let info = SourceInfo::new(file_format, tex.format().channels);
+    let info = SourceInfo::new(file_format, &tex.format());
     Ok(Loaded {
         levels: vec![tex],
         info,
@@ -443,6 +488,9 @@ pub struct SaveOptions {
     pub fingerprint: Option<String>,
     /// More attributes to record (EXR, KTX2).
     pub attributes: Vec<(String, String)>,
+    /// Channel names for EXR output (one per channel, e.g. the source's
+    /// `N.X,N.Y,N.Z`); `None` writes `R,G,B,A`, `Y,A` or `Y`.
+    pub channel_names: Option<Vec<String>>,
 }
 
 impl Default for SaveOptions {
@@ -453,6 +501,7 @@ impl Default for SaveOptions {
             compression: exr::ExrCompression::Zip,
             fingerprint: None,
             attributes: Vec::new(),
+            channel_names: None,
         }
     }
 }

@@ -162,7 +162,10 @@ impl FromStr for AlphaMode {
 /// The alpha channel, when present, is the last one; with
 /// [`AlphaMode::None`] two channels are R, G and four are R, G, B and a
 /// fourth data channel, none of them alpha.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+///
+/// Equality and hashing ignore `alpha` for one and three channels, which
+/// have no alpha channel whatever the field says.
+#[derive(Clone, Copy, Debug)]
 pub struct Format {
     /// Channels per texel, 1 to 4.
     pub channels: u8,
@@ -172,6 +175,41 @@ pub struct Format {
     pub color_space: ColorSpace,
     /// Alpha convention (ignored without an alpha channel).
     pub alpha: AlphaMode,
+}
+
+impl Format {
+    /// The alpha mode that matters: the field for two and four channels,
+    /// [`AlphaMode::Straight`] (the default) otherwise.
+    fn effective_alpha(&self) -> AlphaMode {
+        if self.channels == 2 || self.channels == 4 {
+            self.alpha
+        } else {
+            AlphaMode::Straight
+        }
+    }
+}
+
+impl PartialEq for Format {
+    fn eq(&self, o: &Self) -> bool {
+        self.channels == o.channels
+            && self.channel_type == o.channel_type
+            && self.color_space == o.color_space
+            && self.effective_alpha() == o.effective_alpha()
+    }
+}
+
+impl Eq for Format {}
+
+impl std::hash::Hash for Format {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        (
+            self.channels,
+            self.channel_type,
+            self.color_space,
+            self.effective_alpha(),
+        )
+            .hash(h);
+    }
 }
 
 impl Default for Format {

@@ -5,7 +5,11 @@
 mod util;
 
 mod dds_headers_pillow_read_as_black;
+mod exr_bytes_differ_between_runs;
+mod exr_channel_names_lost;
+mod exr_data_window_offset_dropped;
 mod info_json_silent_on_failure;
+mod multipart_and_multipage_silently_first;
 mod normal_maps_filtered_as_encoded_codes;
 mod premultiplied_exr_written_premultiplied_to_png;
 mod rounding_up_writes_invalid_ktx2;
