@@ -22,11 +22,13 @@ fn jpeg_tiff_and_hdr_inputs_load_with_their_type_and_colour_space() {
     assert_eq!(l.base().format().color_space, ColorSpace::Srgb);
 
     let tif = dir.path().join("c.tiff");
-    image::ImageBuffer::<image::Rgb<u16>, _>::from_fn(5, 3, |x, y| {
-        image::Rgb([x as u16 * 1000, y as u16 * 1000, 65535])
-    })
-    .save(&tif)
-    .unwrap();
+    let px: Vec<u16> = (0..3u16)
+        .flat_map(|y| (0..5u16).flat_map(move |x| [x * 1000, y * 1000, 65535]))
+        .collect();
+    tiff::encoder::TiffEncoder::new(std::fs::File::create(&tif).unwrap())
+        .unwrap()
+        .write_image::<tiff::encoder::colortype::RGB16>(5, 3, &px)
+        .unwrap();
     let l = load(&tif);
     assert_eq!(l.info.format, FileFormat::Tiff);
     assert_eq!(l.base().channel_type(), ChannelType::U16);

@@ -22,6 +22,7 @@ pub mod exr;
 pub mod ktx2;
 pub mod limits;
 pub mod png_levels;
+pub mod tiff;
 
 use std::borrow::Cow;
 use std::fmt;
@@ -257,8 +258,14 @@ pub fn load_with(spec: &str, limits: &Limits, options: &LoadOptions) -> Result<L
             ktx2::load(path, limits)
         } else if magic.starts_with(b"DDS ") {
             dds::load(path, limits)
+        } else if magic.starts_with(b"II*\0")
+            || magic.starts_with(b"MM\0*")
+            || magic.starts_with(b"II+\0")
+            || magic.starts_with(b"MM\0+")
+        {
+            tiff::load(path, limits, options)
         } else {
-            load_image(path, limits)
+            load_image(path, limits, options)
         }
     })
     .unwrap_or_else(|p| {
@@ -286,8 +293,64 @@ pub fn load_chain(spec: &str, limits: &Limits) -> Result<MipChain> {
     }
 }
 
-fn load_image(path: &Path, limits: &Limits) -> Result<Loaded> {
-    use image::{DynamicImage, ImageFormat};
+/// The colour transfer a PNG's chunks declare, as OpenImageIO reads them:
+/// `sRGB` → sRGB; else `cICP` (transfer 13 sRGB, 8 linear); else `gAMA`
+/// (1.0 linear, 1/2.2 sRGB, other exponents sRGB with a note); an `iCCP`
+/// profile is not interpreted (sRGB, with a note unless it names sRGB); no
+/// chunk at all means sRGB, at any bit depth.
+fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>)> {
+    let file = std::fs::File::open(path).map_err(|e| Error::Io {
+        path: path.to_path_buf(),
+        action: "cannot open".into(),
+        error: e,
+    })?;
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .map_err(|e| Error::Decode {
+            format: "PNG",
+            reason: e.to_string(),
+        })?;
+    let info = reader.info();
+    if info.srgb.is_some() {
+        return Ok((ColorSpace::Srgb, None));
+    }
+    if let Some(c) = &info.coding_independent_code_points {
+        return Ok(match c.transfer_function {
+            13 => (ColorSpace::Srgb, None),
+            8 => (ColorSpace::Linear, None),
+            t => (
+                ColorSpace::Srgb,
+                Some(format!(
+                    "cICP transfer characteristics {t} is neither sRGB (13) nor linear (8): read as sRGB"
+                )),
+            ),
+        });
+    }
+    if let Some(g) = info.gama_chunk {
+        let gamma = g.into_value() as f64;
+        if (gamma - 1.0).abs() < 0.01 {
+            return Ok((ColorSpace::Linear, None));
+        }
+        let note = ((1.0 / gamma - 2.2).abs() > 0.05).then(|| {
+            format!(
+                "gAMA {gamma:.5} (a {:.2} power law) read as sRGB, parvo's nearest transfer",
+                1.0 / gamma
+            )
+        });
+        return Ok((ColorSpace::Srgb, note));
+    }
+    if let Some(icc) = &info.icc_profile {
+        let names_srgb = icc.windows(4).any(|w| w == b"sRGB");
+        return Ok((
+            ColorSpace::Srgb,
+            (!names_srgb).then(|| "the ICC profile is not interpreted: read as sRGB".to_string()),
+        ));
+    }
+    Ok((ColorSpace::Srgb, None))
+}
+
+fn load_image(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loaded> {
+    use image::{DynamicImage, ImageDecoder, ImageFormat};
     let decode = |reason: String| Error::Decode {
         format: "image",
         reason,
@@ -303,7 +366,6 @@ fn load_image(path: &Path, limits: &Limits) -> Result<Loaded> {
     let file_format = match reader.format() {
         Some(ImageFormat::Png) => FileFormat::Png,
         Some(ImageFormat::Jpeg) => FileFormat::Jpeg,
-        Some(ImageFormat::Tiff) => FileFormat::Tiff,
         Some(ImageFormat::Hdr) => FileFormat::Hdr,
         _ => {
             return Err(decode(
@@ -312,8 +374,15 @@ fn load_image(path: &Path, limits: &Limits) -> Result<Loaded> {
             ));
         }
     };
-    reader.limits(limits.to_image());
-    let img = reader.decode().map_err(|e| match e {
+    let mut notes = Vec::new();
+    let png_cs = if file_format == FileFormat::Png {
+        let (cs, note) = png_transfer(path)?;
+        notes.extend(note);
+        Some(cs)
+    } else {
+        None
+    };
+    let lim = |e: image::ImageError| match e {
         image::ImageError::Limits(l) => Error::Limits(format!(
             "{l} (raise with --max-width/--max-height/--max-alloc)"
         )),
@@ -321,19 +390,24 @@ fn load_image(path: &Path, limits: &Limits) -> Result<Loaded> {
             format: file_format.name(),
             reason: other.to_string(),
         },
-    })?;
+    };
+    reader.limits(limits.to_image());
+    let mut decoder = reader.into_decoder().map_err(lim)?;
+    let orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
+    let mut il = limits.to_image();
+    il.reserve(decoder.total_bytes()).map_err(lim)?;
+    let img = DynamicImage::from_decoder(decoder).map_err(lim)?;
     let (w, h) = (img.width(), img.height());
-    let srgb8 = matches!(file_format, FileFormat::Png | FileFormat::Jpeg);
     let f = |ch: u8, ty: ChannelType| {
-        let cs = if srgb8 && ty == ChannelType::U8 {
-            ColorSpace::Srgb
-        } else {
-            ColorSpace::Linear
+        let cs = match (file_format, png_cs) {
+            (FileFormat::Png, Some(cs)) if !ty.is_float() => cs,
+            (FileFormat::Jpeg, _) if ty == ChannelType::U8 => ColorSpace::Srgb,
+            _ => ColorSpace::Linear,
         };
         Format::new(ch, ty, cs)
     };
     use ChannelType::*;
-    let tex = match img {
+    let mut tex = match img {
         DynamicImage::ImageLuma8(b) => Texture::from_u8(w, h, f(1, U8), b.into_raw()),
         DynamicImage::ImageLumaA8(b) => Texture::from_u8(w, h, f(2, U8), b.into_raw()),
         DynamicImage::ImageRgb8(b) => Texture::from_u8(w, h, f(3, U8), b.into_raw()),
@@ -345,11 +419,86 @@ fn load_image(path: &Path, limits: &Limits) -> Result<Loaded> {
         DynamicImage::ImageRgb32F(b) => Texture::from_f32(w, h, f(3, F32), b.into_raw()),
         other => Texture::from_f32(w, h, f(4, F32), other.into_rgba32f().into_raw()),
     }?;
-    let info = SourceInfo::new(file_format, &tex.format());
+    let mut attributes = Vec::new();
+    if orientation != 1 {
+        attributes.push(("Orientation".to_string(), orientation.to_string()));
+        if options.auto_orient {
+            tex = orient(&tex, orientation)?;
+            notes.push(format!(
+                "EXIF orientation {orientation} applied (--no-auto-orient keeps the stored order)"
+            ));
+        } else {
+            notes.push(format!(
+                "EXIF orientation {orientation} not applied (--no-auto-orient)"
+            ));
+        }
+    }
+    let mut info = SourceInfo::new(file_format, &tex.format());
+    info.attributes = attributes;
+    info.notes = notes;
     Ok(Loaded {
         levels: vec![tex],
         info,
     })
+}
+
+/// `t` turned by an EXIF/TIFF orientation code (1–8: how the stored rows
+/// map to the displayed image), so that row 0 is the top of the picture:
+/// 2 mirrors, 3 turns 180°, 4 flips, 5 transposes, 6 turns 90° clockwise,
+/// 7 transverses, 8 turns 90° anticlockwise. Codes outside 1–8 are an
+/// error.
+pub fn orient(t: &Texture, code: u16) -> Result<Texture> {
+    let (w, h) = (t.width() as usize, t.height() as usize);
+    let swap = matches!(code, 5..=8);
+    let (ow, oh) = if swap { (h, w) } else { (w, h) };
+    // Source texel of output texel (x, y).
+    let src = |x: usize, y: usize| -> (usize, usize) {
+        match code {
+            2 => (w - 1 - x, y),
+            3 => (w - 1 - x, h - 1 - y),
+            4 => (x, h - 1 - y),
+            5 => (y, x),
+            6 => (y, h - 1 - x),
+            7 => (w - 1 - y, h - 1 - x),
+            8 => (w - 1 - y, x),
+            _ => (x, y),
+        }
+    };
+    if !(1..=8).contains(&code) {
+        return Err(Error::Decode {
+            format: "image",
+            reason: format!("orientation {code} is not an EXIF orientation (1 to 8)"),
+        });
+    }
+    if code == 1 {
+        return Ok(t.clone());
+    }
+    let ch = t.channels();
+    fn turn<T: Copy>(
+        v: &[T],
+        ch: usize,
+        w: usize,
+        ow: usize,
+        oh: usize,
+        src: &dyn Fn(usize, usize) -> (usize, usize),
+    ) -> Vec<T> {
+        let mut out = Vec::with_capacity(v.len());
+        for y in 0..oh {
+            for x in 0..ow {
+                let (sx, sy) = src(x, y);
+                let i = (sy * w + sx) * ch;
+                out.extend_from_slice(&v[i..i + ch]);
+            }
+        }
+        out
+    }
+    let texels = match t.texels() {
+        Texels::U8(v) => Texels::U8(turn(v, ch, w, ow, oh, &src)),
+        Texels::U16(v) => Texels::U16(turn(v, ch, w, ow, oh, &src)),
+        Texels::F16(v) => Texels::F16(turn(v, ch, w, ow, oh, &src)),
+        Texels::F32(v) => Texels::F32(turn(v, ch, w, ow, oh, &src)),
+    };
+    Texture::from_texels(ow as u32, oh as u32, t.format(), texels)
 }
 
 /// The stored values as little-endian bytes (borrowed on little-endian

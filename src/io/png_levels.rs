@@ -5,13 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
-use image::ExtendedColorType;
-use image::ImageEncoder;
-use image::codecs::png::PngEncoder;
-
 use super::atomic;
 use crate::error::{Error, Result};
-use crate::texel::Texels;
+use crate::texel::{ColorSpace, Texels};
 use crate::texture::Texture;
 
 fn encode_err(reason: impl std::fmt::Display) -> Error {
@@ -30,25 +26,49 @@ pub fn level_path(template: &Path, k: usize) -> PathBuf {
     )
 }
 
-/// Encode one texture as PNG into `out`. PNG's two-channel layout is grey +
-/// alpha, so R, G data (no alpha) is written as RGB with B = 0.
+/// Encode one texture as PNG into `out`, with the chunk that says its
+/// transfer: `sRGB` (with the `gAMA` and `cHRM` that go with it) for sRGB
+/// data, `gAMA` 1.0 for linear data, so that parvo and OpenImageIO read the
+/// levels back as what they are; and a `Software` text chunk naming parvo.
+/// PNG's two-channel layout is grey + alpha, so R, G data (no alpha) is
+/// written as RGB with B = 0.
 pub fn write_png(t: &Texture, out: &mut impl std::io::Write) -> Result<()> {
-    use ExtendedColorType::*;
     if t.channels() == 2 && !t.format().has_alpha() {
         return write_png(&super::expand_channels(t, 3)?, out);
     }
-    let (bytes, color): (&[u8], _) = match t.texels() {
-        Texels::U8(v) => (v.as_slice(), [L8, La8, Rgb8, Rgba8][t.channels() - 1]),
-        Texels::U16(v) => (
-            bytemuck::cast_slice(v.as_slice()),
-            [L16, La16, Rgb16, Rgba16][t.channels() - 1],
-        ),
+    let color = [
+        png::ColorType::Grayscale,
+        png::ColorType::GrayscaleAlpha,
+        png::ColorType::Rgb,
+        png::ColorType::Rgba,
+    ][t.channels() - 1];
+    let be16;
+    let (bytes, depth): (&[u8], _) = match t.texels() {
+        Texels::U8(v) => (v.as_slice(), png::BitDepth::Eight),
+        Texels::U16(v) => {
+            be16 = v.iter().flat_map(|x| x.to_be_bytes()).collect::<Vec<u8>>();
+            (be16.as_slice(), png::BitDepth::Sixteen)
+        }
         _ => return Err(encode_err("PNG stores 8- or 16-bit texels, not floats")),
     };
-    PngEncoder::new(out)
-        .write_image(bytes, t.width(), t.height(), color)
-        .map_err(encode_err)
+    let mut enc = png::Encoder::new(out, t.width(), t.height());
+    enc.set_color(color);
+    enc.set_depth(depth);
+    enc.set_compression(png::Compression::Balanced);
+    match t.format().color_space {
+        ColorSpace::Srgb => enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual),
+        ColorSpace::Linear => enc.set_source_gamma(png::ScaledFloat::new(1.0)),
+    }
+    enc.add_text_chunk("Software".into(), SOFTWARE.into())
+        .map_err(encode_err)?;
+    let mut w = enc.write_header().map_err(encode_err)?;
+    w.write_image_data(bytes).map_err(encode_err)?;
+    w.finish().map_err(encode_err)
 }
+
+/// The `Software` text parvo writes into its PNG levels (and looks for
+/// before it removes a stale level).
+pub const SOFTWARE: &str = concat!("parvo ", env!("CARGO_PKG_VERSION"));
 
 /// Write every level to its own PNG, atomically as a set.
 pub fn save(levels: &[Texture], template: &Path) -> Result<()> {

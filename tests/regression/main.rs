@@ -5,12 +5,17 @@
 mod util;
 
 mod dds_headers_pillow_read_as_black;
+mod exif_orientation_ignored;
 mod exr_bytes_differ_between_runs;
 mod exr_channel_names_lost;
 mod exr_data_window_offset_dropped;
+mod float_tiff_one_two_channels_refused;
 mod info_json_silent_on_failure;
+mod maketx_tx_read_as_one_level;
 mod multipart_and_multipage_silently_first;
 mod normal_maps_filtered_as_encoded_codes;
+mod png_colour_chunks_ignored;
 mod premultiplied_exr_written_premultiplied_to_png;
 mod rounding_up_writes_invalid_ktx2;
 mod sample_ignores_recorded_wrap_modes;
+mod tiff_associated_alpha_premultiplied_twice;

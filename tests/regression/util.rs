@@ -109,3 +109,30 @@ pub fn png_u16(path: &Path) -> (u32, u32, usize, Vec<u16>) {
     };
     (w, h, ch, v)
 }
+
+/// A TIFF written with the `tiff` crate's encoder: one directory per
+/// `(width, height, samples)` entry, 8-bit samples of colour type `C`, each
+/// with the extra tags given (`ExtraSamples`, Pixar's `textureformat`, ...).
+pub fn write_tiff_u8<C>(path: &Path, dirs: &[(u32, u32, Vec<u8>)], tags: &[(u16, TagValue)])
+where
+    C: tiff::encoder::colortype::ColorType<Inner = u8>,
+{
+    let mut enc = tiff::encoder::TiffEncoder::new(std::fs::File::create(path).unwrap()).unwrap();
+    for (w, h, px) in dirs {
+        let mut img = enc.new_image::<C>(*w, *h).unwrap();
+        for (tag, v) in tags {
+            let t = tiff::tags::Tag::from_u16_exhaustive(*tag);
+            match v {
+                TagValue::Short(s) => img.encoder().write_tag(t, s.as_slice()).unwrap(),
+                TagValue::Ascii(s) => img.encoder().write_tag(t, s.as_str()).unwrap(),
+            }
+        }
+        img.write_data(px).unwrap();
+    }
+}
+
+/// A tag value for [`write_tiff_u8`].
+pub enum TagValue {
+    Short(Vec<u16>),
+    Ascii(String),
+}
