@@ -76,7 +76,8 @@ pub enum ExtArg {
     long_about = "Build mip-mapped textures from images, as maketx, nvtt_export or toktx do.\n\n\
     `parvo mip INPUT -o OUTPUT` writes one file; `parvo mip INPUT... --out-dir DIR` writes a batch \
     in parallel. The output container follows the extension: .exr (tiled, mip-mapped OpenEXR), \
-    .ktx2, .dds, or a name containing {level} for one PNG per level. Outputs are written \
+    .ktx2, .dds, or a .png name containing {level} for one PNG per level (a re-run with a shorter \
+    chain removes the higher levels parvo wrote before). Outputs are written \
     atomically (temporary file + rename): an error or an interrupt never leaves a truncated file.\n\n\
     Exit codes: 0 every input succeeded; 1 some input failed (the others were written); 2 usage error."
 )]
@@ -604,7 +605,7 @@ fn process(
     let loaded = io::load_with(&job.input, limits, &load_options)?;
     let src_kind = loaded.info.format;
     let file_wrap = loaded.info.wrap;
-    let notes = loaded.info.notes.clone();
+    let mut notes = loaded.info.notes.clone();
     let channel_names = loaded.info.channel_names.clone();
     let mut base = loaded.into_base();
     // Interpretation of the input.
@@ -632,6 +633,7 @@ fn process(
         rounding: args.rounding,
         max_levels: args.levels,
         alpha_coverage: args.alpha_coverage,
+        alpha_store: Some(out_format.channel_type),
         normal_map: args.normal_map,
         nan_policy: args.fixnan,
         fast_paths: true,
@@ -697,15 +699,19 @@ fn process(
     };
     let association =
         (out_format.has_alpha() && src.alpha != out_format.alpha).then_some(out_format.alpha);
+    // Alpha coverage is matched on the unrounded filtered alpha (rounding
+    // each level to 8 bits first would tie texels the test must separate),
+    // so it always builds in f32.
     let same = src.channel_type == out_format.channel_type
         && src.color_space == out_format.color_space
-        && association.is_none();
+        && association.is_none()
+        && args.alpha_coverage.is_none();
     let levels = if args.normal_map {
         // Decoded to vectors, averaged in f32, encoded once per level into
         // the output type (parvo::mip::normal).
         mip::normal::build(base, &options, out_format, &mut on_progress)?
     } else {
-        build_colour(
+        let (levels, clip_note) = build_colour(
             base,
             &options,
             src,
@@ -713,7 +719,9 @@ fn process(
             association,
             same,
             &mut on_progress,
-        )?
+        )?;
+        notes.extend(clip_note);
+        levels
     };
     let build_s = t_build.elapsed().as_secs_f64();
     if let Some(b) = bar {
@@ -739,6 +747,33 @@ fn process(
     };
     io::save(&levels, args.rounding, &job.output, job.kind, &save)
         .with_context(|| format!("writing {}", job.output.display()))?;
+    if job.kind == OutputKind::PngLevels {
+        // Levels an earlier, longer chain left behind under this template.
+        let stale = io::png_levels::remove_stale(&job.output, levels.len())?;
+        if !stale.removed.is_empty() {
+            notes.push(format!(
+                "removed {} stale level file(s) of an earlier run: {}",
+                stale.removed.len(),
+                stale
+                    .removed
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+        if !stale.foreign.is_empty() {
+            notes.push(format!(
+                "left alone (not written by parvo): {}",
+                stale
+                    .foreign
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+    }
     let write_s = t_write.elapsed().as_secs_f64();
     Ok(Outcome {
         output: job.output.clone(),
@@ -765,7 +800,7 @@ fn build_colour(
     association: Option<AlphaMode>,
     same: bool,
     progress: &mut dyn FnMut(mip::Progress),
-) -> anyhow::Result<Vec<Texture>> {
+) -> anyhow::Result<(Vec<Texture>, Option<String>)> {
     let work_base = if same {
         base
     } else {
@@ -780,16 +815,53 @@ fn build_colour(
         Texture::from_f32(w, h, f, linear)?
     };
     let chain: MipChain = mip::build_with_progress(work_base, options, progress)?;
+    // Float data (HDR) written to a normalised type is clipped to [0, 1]:
+    // count the texels that lose something, to say so once.
+    let count_clipped = src.channel_type.is_float() && !out_format.channel_type.is_float();
+    let mut clipped = 0u64;
+    let mut texels = 0u64;
     // Smallest level first, so level 0's f32 and converted copies never
     // coexist with the unconverted rest of the chain.
-    let mut levels: Vec<Texture> = chain
-        .into_levels()
-        .into_iter()
-        .rev()
-        .map(|l| convert_level(l, out_format, association))
-        .collect::<anyhow::Result<_>>()?;
+    let mut levels: Vec<Texture> = Vec::with_capacity(chain.len());
+    for l in chain.into_levels().into_iter().rev() {
+        let l = associate(l, association)?;
+        if count_clipped {
+            clipped += outside_unit_range(&l);
+            texels += l.texel_count() as u64;
+        }
+        levels.push(convert_level(l, out_format)?);
+    }
     levels.reverse();
-    Ok(levels)
+    let note = (clipped > 0).then(|| {
+        format!(
+            "{clipped} of {texels} texels (all levels) hold values outside 0..1 and are clipped \
+             to the {} range; keep a float output (.exr, or --type f16) to keep them",
+            out_format.channel_type
+        )
+    });
+    Ok((levels, note))
+}
+
+/// Texels with a channel outside [0, 1] (or NaN).
+fn outside_unit_range(l: &Texture) -> u64 {
+    let ch = l.channels();
+    let count = |v: &[f32]| {
+        v.par_chunks(ch * 4096)
+            .map(|rows| {
+                rows.chunks_exact(ch)
+                    .filter(|p| p.iter().any(|x| !(0.0..=1.0).contains(x)))
+                    .count() as u64
+            })
+            .sum::<u64>()
+    };
+    match l.texels() {
+        Texels::F32(v) => count(v),
+        Texels::F16(v) => {
+            let f: Vec<f32> = v.iter().map(|x| x.to_f32()).collect();
+            count(&f)
+        }
+        _ => 0,
+    }
 }
 
 /// `--color auto`: sRGB for 8-bit PNG and JPEG (what the loader already
@@ -805,35 +877,35 @@ fn auto_color(kind: FileFormat, f: Format) -> ColorSpace {
     }
 }
 
-/// Convert a built level to the output format (type, colour space, alpha
-/// association, and channel widening for containers that need it).
-fn convert_level(
-    mut l: Texture,
-    out: Format,
-    association: Option<AlphaMode>,
-) -> anyhow::Result<Texture> {
-    if let Some(to) = association {
-        // Built in linear f32 (see `process`).
-        let ch = l.channels();
-        let Texels::F32(v) = l.texels_mut() else {
-            anyhow::bail!("changing the alpha association needs f32 levels");
-        };
-        let premultiply = to == AlphaMode::Premultiplied;
-        v.par_chunks_mut(ch * 4096).for_each(|rows| {
-            for px in rows.chunks_exact_mut(ch) {
-                let a = px[ch - 1];
-                if premultiply {
-                    px[..ch - 1].iter_mut().for_each(|c| *c *= a);
-                } else if a != 0.0 {
-                    // Where alpha is 0 the colour is kept, as oiiotool's
-                    // --unpremult does.
-                    px[..ch - 1].iter_mut().for_each(|c| *c /= a);
-                }
+/// Change the alpha association of a level built in linear f32 (see
+/// `process`): premultiply, or divide colour by alpha (where alpha is 0
+/// the colour is kept, as oiiotool's --unpremult does).
+fn associate(mut l: Texture, association: Option<AlphaMode>) -> anyhow::Result<Texture> {
+    let Some(to) = association else {
+        return Ok(l);
+    };
+    let ch = l.channels();
+    let Texels::F32(v) = l.texels_mut() else {
+        anyhow::bail!("changing the alpha association needs f32 levels");
+    };
+    let premultiply = to == AlphaMode::Premultiplied;
+    v.par_chunks_mut(ch * 4096).for_each(|rows| {
+        for px in rows.chunks_exact_mut(ch) {
+            let a = px[ch - 1];
+            if premultiply {
+                px[..ch - 1].iter_mut().for_each(|c| *c *= a);
+            } else if a != 0.0 {
+                px[..ch - 1].iter_mut().for_each(|c| *c /= a);
             }
-        });
-        let f = l.format().with_alpha(to);
-        l = l.reinterpret(f)?;
-    }
+        }
+    });
+    let f = l.format().with_alpha(to);
+    Ok(l.reinterpret(f)?)
+}
+
+/// Convert a built level to the output format (type, colour space, and
+/// channel widening for containers that need it).
+fn convert_level(l: Texture, out: Format) -> anyhow::Result<Texture> {
     let narrow = Format {
         channels: l.format().channels,
         ..out

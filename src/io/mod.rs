@@ -578,7 +578,7 @@ pub enum OutputKind {
     Ktx2,
     /// `.dds`: DDS, uncompressed, legacy or DX10 header as the format needs.
     Dds,
-    /// A name containing `{level}`: one PNG per level.
+    /// A name containing `{level}` and ending in `.png`: one PNG per level.
     PngLevels,
 }
 
@@ -587,13 +587,23 @@ impl OutputKind {
     /// one PNG per level, otherwise the extension decides.
     pub fn from_path(path: &Path) -> Result<Self> {
         let s = path.to_string_lossy();
-        if s.contains("{level}") {
-            return Ok(OutputKind::PngLevels);
-        }
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
+        if s.contains("{level}") {
+            // One file per level is PNG's way; the other containers hold the
+            // whole chain in one file, and a `.exr` name must not get PNG
+            // bytes.
+            return if ext == "png" {
+                Ok(OutputKind::PngLevels)
+            } else {
+                Err(Error::InvalidOption(format!(
+                    "output `{s}`: a {{level}} template writes one PNG per level, so it must end in .png \
+                     (.exr, .ktx2 and .dds hold the whole chain in one file: drop {{level}})"
+                )))
+            };
+        }
         match ext.as_str() {
             "exr" => Ok(OutputKind::Exr),
             "ktx2" => Ok(OutputKind::Ktx2),

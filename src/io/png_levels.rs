@@ -83,3 +83,50 @@ pub fn save(levels: &[Texture], template: &Path) -> Result<()> {
     }
     Ok(())
 }
+
+/// What [`remove_stale`] did with level files past the new chain.
+#[derive(Debug, Default, PartialEq, Eq)]
+pub struct Stale {
+    /// Files parvo had written (their `Software` text says so), removed.
+    pub removed: Vec<PathBuf>,
+    /// Files of the template's names that parvo did not write, left alone.
+    pub foreign: Vec<PathBuf>,
+}
+
+/// After writing `count` levels to `template`, remove the levels `count`,
+/// `count + 1`, ... that an earlier, longer chain left behind, but only
+/// files whose PNG `Software` text names parvo; other files of those names
+/// are kept and listed.
+pub fn remove_stale(template: &Path, count: usize) -> Result<Stale> {
+    let mut out = Stale::default();
+    for k in count..64 {
+        let p = level_path(template, k);
+        if !p.is_file() {
+            continue;
+        }
+        let ours = std::fs::File::open(&p)
+            .ok()
+            .and_then(|f| {
+                png::Decoder::new(std::io::BufReader::new(f))
+                    .read_info()
+                    .ok()
+            })
+            .is_some_and(|r| {
+                r.info()
+                    .uncompressed_latin1_text
+                    .iter()
+                    .any(|t| t.keyword == "Software" && t.text.starts_with("parvo "))
+            });
+        if ours {
+            std::fs::remove_file(&p).map_err(|e| Error::Io {
+                path: p.clone(),
+                action: "cannot remove a stale level".into(),
+                error: e,
+            })?;
+            out.removed.push(p);
+        } else {
+            out.foreign.push(p);
+        }
+    }
+    Ok(out)
+}

@@ -160,6 +160,11 @@ pub struct MipOptions {
     /// the components) and build the chain from unit vectors, renormalising
     /// each level once in full precision ([`normal`]). Default: false.
     pub normal_map: bool,
+    /// The channel type the levels' alpha will be stored in, when it is
+    /// not the type they are built in (a chain built in f32 for 8-bit
+    /// output): alpha coverage is measured after that rounding. `None`
+    /// (default): the build type.
+    pub alpha_store: Option<crate::texel::ChannelType>,
     /// What to do with NaN/Inf in float input. Default: error.
     pub nan_policy: NanPolicy,
     /// Use the fast paths where they apply. Default: true. Turning it off
@@ -175,6 +180,7 @@ impl Default for MipOptions {
             rounding: Rounding::Down,
             max_levels: None,
             alpha_coverage: None,
+            alpha_store: None,
             normal_map: false,
             nan_policy: NanPolicy::Error,
             fast_paths: true,
@@ -363,7 +369,8 @@ fn reduce_post(
 ) -> Result<(Texture, bool)> {
     let (mut next, finite) = reduce_tracked(prev, w, h, options)?;
     if let (Some(r), Some(c0)) = (options.alpha_coverage, coverage0) {
-        alpha::preserve_coverage(&mut next, r, c0);
+        let store = options.alpha_store.unwrap_or(next.channel_type());
+        alpha::preserve_coverage(&mut next, r, c0, store);
     }
     Ok((next, finite))
 }

@@ -4,13 +4,16 @@
 
 mod util;
 
+mod alpha_coverage_bound_broken_by_8bit_rounding;
 mod dds_headers_pillow_read_as_black;
 mod exif_orientation_ignored;
 mod exr_bytes_differ_between_runs;
 mod exr_channel_names_lost;
 mod exr_data_window_offset_dropped;
 mod float_tiff_one_two_channels_refused;
+mod hdr_clipping_unreported;
 mod info_json_silent_on_failure;
+mod level_template_ignores_extension;
 mod maketx_tx_read_as_one_level;
 mod multipart_and_multipage_silently_first;
 mod normal_maps_filtered_as_encoded_codes;
