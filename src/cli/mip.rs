@@ -35,7 +35,8 @@ use parvo::{Texture, Wrap};
 /// How to interpret the colour channels of the input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ColorArg {
-    /// sRGB for 8-bit PNG and JPEG, linear for everything else.
+    /// What the file says: PNG by its sRGB/cICP/gAMA chunks (sRGB when it has none), JPEG sRGB,
+    /// KTX2 and DDS by their format, OpenEXR, TIFF and HDR linear.
     Auto,
     /// The input is linear light.
     Linear,
@@ -613,7 +614,8 @@ fn process(
     src.color_space = match (args.color, args.normal_map) {
         (ColorArg::Linear, _) | (ColorArg::Auto, true) => ColorSpace::Linear,
         (ColorArg::Srgb, _) => ColorSpace::Srgb,
-        (ColorArg::Auto, false) => auto_color(src_kind, src),
+        // The loader's reading of the file (see io::load).
+        (ColorArg::Auto, false) => src.color_space,
     };
     src.alpha = match args.alpha {
         // A normal map's fourth channel is data, not alpha.
@@ -861,19 +863,6 @@ fn outside_unit_range(l: &Texture) -> u64 {
             count(&f)
         }
         _ => 0,
-    }
-}
-
-/// `--color auto`: sRGB for 8-bit PNG and JPEG (what the loader already
-/// says), the loader's choice for files that record it, linear otherwise.
-fn auto_color(kind: FileFormat, f: Format) -> ColorSpace {
-    match kind {
-        FileFormat::Png
-        | FileFormat::Jpeg
-        | FileFormat::Ktx2
-        | FileFormat::Dds
-        | FileFormat::Builtin => f.color_space,
-        _ => ColorSpace::Linear,
     }
 }
 

@@ -782,10 +782,13 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         ));
     }
     attributes.sort();
-    let wrap = attributes
-        .iter()
-        .find(|(k, _)| k == "wrapmodes")
-        .and_then(|(_, v)| v.parse().ok());
+    let wrap = super::recorded_wrap(
+        attributes
+            .iter()
+            .find(|(k, _)| k == "wrapmodes")
+            .map(|(_, v)| v.as_str()),
+        &mut notes,
+    );
 
     let reader = ::exr::prelude::read()
         .no_deep_data()

@@ -349,11 +349,16 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         .collect();
     attributes.push(("vkFormat".into(), format!("{:?}", h.format)));
     attributes.sort();
-    let wrap = attributes
-        .iter()
-        .find(|(k, _)| k == "parvo:wrapmodes")
-        .and_then(|(_, v)| v.parse().ok());
+    let mut notes = Vec::new();
+    let wrap = super::recorded_wrap(
+        attributes
+            .iter()
+            .find(|(k, _)| k == "parvo:wrapmodes")
+            .map(|(_, v)| v.as_str()),
+        &mut notes,
+    );
     let mut info = SourceInfo::new(FileFormat::Ktx2, &format);
+    info.notes = notes;
     info.channel_names = match format.channels {
         1 => vec!["R".into()],
         2 => vec!["R".into(), "G".into()],

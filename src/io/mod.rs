@@ -166,6 +166,22 @@ impl Loaded {
     }
 }
 
+/// A recorded `wrapmodes` text as wrap modes; one that does not parse is
+/// noted (and repeat applies) rather than dropped without a word.
+pub(crate) fn recorded_wrap(text: Option<&str>, notes: &mut Vec<String>) -> Option<Wrap> {
+    let t = text?;
+    match t.parse() {
+        Ok(w) => Some(w),
+        Err(_) => {
+            notes.push(format!(
+                "wrap modes `{t}` not understood (expected MODE or U,V of repeat/periodic, mirror, \
+                 clamp, black/border, mirror-clamp): repeat applies unless --wrap says otherwise"
+            ));
+            None
+        }
+    }
+}
+
 /// Choices a loader cannot make from the file alone.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LoadOptions {

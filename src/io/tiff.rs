@@ -416,7 +416,7 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     let mut info = SourceInfo::new(FileFormat::Tiff, &format);
     info.own_mips = levels.len() > 1;
     info.rounding = rounding;
-    info.wrap = wrap_text.and_then(|w| w.parse().ok());
+    info.wrap = super::recorded_wrap(wrap_text.as_deref(), &mut notes);
     info.tile = dir0.tile;
     info.attributes = attributes;
     info.notes = notes;
