@@ -104,7 +104,16 @@ pub struct MipArgs {
     filter: MipFilter,
 
     /// Colour space of the input.
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(
+        long,
+        value_enum,
+        default_value = "auto",
+        long_help = "Colour space of the input. auto: what the file says (PNG by its sRGB, cICP or \
+        gAMA chunk, sRGB when it has none, as OpenImageIO reads it; JPEG sRGB; KTX2 and DDS by their \
+        format; OpenEXR, TIFF and HDR linear). sRGB is decoded and encoded with the exact IEC \
+        61966-2-1 curve, which OpenImageIO's built-in transform departs from by up to about 0.004 \
+        in linear light; filtering is in linear light."
+    )]
     color: ColorArg,
 
     /// Alpha convention of the input: auto, straight, premultiplied or none.
