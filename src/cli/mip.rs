@@ -761,27 +761,23 @@ fn process(
     if job.kind == OutputKind::PngLevels {
         // Levels an earlier, longer chain left behind under this template.
         let stale = io::png_levels::remove_stale(&job.output, levels.len())?;
+        let list = |v: &[PathBuf]| {
+            v.iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         if !stale.removed.is_empty() {
             notes.push(format!(
                 "removed {} stale level file(s) of an earlier run: {}",
                 stale.removed.len(),
-                stale
-                    .removed
-                    .iter()
-                    .map(|p| p.display().to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                list(&stale.removed)
             ));
         }
         if !stale.foreign.is_empty() {
             notes.push(format!(
                 "left alone (not written by parvo): {}",
-                stale
-                    .foreign
-                    .iter()
-                    .map(|p| p.display().to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                list(&stale.foreign)
             ));
         }
     }

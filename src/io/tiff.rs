@@ -189,6 +189,13 @@ fn directory<R: Read + Seek>(d: &mut Decoder<R>) -> Result<Directory> {
     })
 }
 
+/// The first `want` samples of a decoded image, interleaved when the file
+/// is planar.
+fn take<T: Copy>(mut v: Vec<T>, want: usize, planar: bool, samples: usize, n: usize) -> Vec<T> {
+    v.truncate(want);
+    if planar { interleave(v, samples, n) } else { v }
+}
+
 /// Interleave planar data (all of channel 0, then channel 1, ...).
 fn interleave<T: Copy>(v: Vec<T>, ch: usize, n: usize) -> Vec<T> {
     if ch == 1 {
@@ -224,52 +231,28 @@ fn read_texture<R: Read + Seek>(d: &mut Decoder<R>, dir: &Directory) -> Result<T
             Ok(())
         }
     };
+    let len = match &result {
+        DecodingResult::U8(v) => v.len(),
+        DecodingResult::U16(v) => v.len(),
+        DecodingResult::F16(v) => v.len(),
+        DecodingResult::F32(v) => v.len(),
+        DecodingResult::F64(v) => v.len(),
+        _ => return Err(decode_err("unexpected sample type from the decoder")),
+    };
+    check(len)?;
+    let (planar, samples) = (dir.planar, dir.samples);
     let texels = match result {
-        DecodingResult::U8(mut v) => {
-            check(v.len())?;
-            v.truncate(want);
-            Texels::U8(if dir.planar {
-                interleave(v, dir.samples, n)
-            } else {
-                v
-            })
-        }
-        DecodingResult::U16(mut v) => {
-            check(v.len())?;
-            v.truncate(want);
-            Texels::U16(if dir.planar {
-                interleave(v, dir.samples, n)
-            } else {
-                v
-            })
-        }
-        DecodingResult::F16(mut v) => {
-            check(v.len())?;
-            v.truncate(want);
-            Texels::F16(if dir.planar {
-                interleave(v, dir.samples, n)
-            } else {
-                v
-            })
-        }
-        DecodingResult::F32(mut v) => {
-            check(v.len())?;
-            v.truncate(want);
-            Texels::F32(if dir.planar {
-                interleave(v, dir.samples, n)
-            } else {
-                v
-            })
-        }
-        DecodingResult::F64(v) => {
-            check(v.len())?;
-            let v: Vec<f32> = v[..want].iter().map(|&x| x as f32).collect();
-            Texels::F32(if dir.planar {
-                interleave(v, dir.samples, n)
-            } else {
-                v
-            })
-        }
+        DecodingResult::U8(v) => Texels::U8(take(v, want, planar, samples, n)),
+        DecodingResult::U16(v) => Texels::U16(take(v, want, planar, samples, n)),
+        DecodingResult::F16(v) => Texels::F16(take(v, want, planar, samples, n)),
+        DecodingResult::F32(v) => Texels::F32(take(v, want, planar, samples, n)),
+        DecodingResult::F64(v) => Texels::F32(take(
+            v.into_iter().map(|x| x as f32).collect(),
+            want,
+            planar,
+            samples,
+            n,
+        )),
         _ => return Err(decode_err("unexpected sample type from the decoder")),
     };
     Texture::from_texels(dir.width, dir.height, dir.format, texels)

@@ -62,16 +62,19 @@ fn reference(n0: &[[f64; 3]], w: usize, k: u32) -> Vec<[f64; 3]> {
     out
 }
 
-#[test]
-fn u8_normal_png_to_exr_decodes_codes_and_filters_unit_vectors() {
-    let dir = tempfile::tempdir().unwrap();
-    let (w, h) = (16usize, 8usize);
-    let n = normals(w, h, 7);
+/// `n` written as an RGB8 normal map (codes round((n + 1) / 2 · 255)),
+/// and the unit vectors those codes decode to (2c − 1, normalised).
+fn normal_png(
+    dir: &std::path::Path,
+    n: &[[f64; 3]],
+    w: usize,
+    h: usize,
+) -> (std::path::PathBuf, Vec<[f64; 3]>) {
     let codes: Vec<u8> = n
         .iter()
         .flat_map(|v| v.map(|c| ((c + 1.0) / 2.0 * 255.0).round() as u8))
         .collect();
-    let src = dir.path().join("normal.png");
+    let src = dir.join("normal.png");
     image::save_buffer(
         &src,
         &codes,
@@ -80,10 +83,19 @@ fn u8_normal_png_to_exr_decodes_codes_and_filters_unit_vectors() {
         image::ExtendedColorType::Rgb8,
     )
     .unwrap();
-    let decoded: Vec<[f64; 3]> = codes
+    let decoded = codes
         .chunks(3)
         .map(|c| norm([0, 1, 2].map(|i| c[i] as f64 / 255.0 * 2.0 - 1.0)))
         .collect();
+    (src, decoded)
+}
+
+#[test]
+fn u8_normal_png_to_exr_decodes_codes_and_filters_unit_vectors() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (16usize, 8usize);
+    let n = normals(w, h, 7);
+    let (src, decoded) = normal_png(dir.path(), &n, w, h);
     let out = dir.path().join("normal.exr");
     ok(&parvo(&[
         "mip",
@@ -112,23 +124,7 @@ fn u8_levels_are_renormalised_without_an_intermediate_rounding() {
     let dir = tempfile::tempdir().unwrap();
     let (w, h) = (32usize, 32usize);
     let n = normals(w, h, 11);
-    let codes: Vec<u8> = n
-        .iter()
-        .flat_map(|v| v.map(|c| ((c + 1.0) / 2.0 * 255.0).round() as u8))
-        .collect();
-    let src = dir.path().join("normal.png");
-    image::save_buffer(
-        &src,
-        &codes,
-        w as u32,
-        h as u32,
-        image::ExtendedColorType::Rgb8,
-    )
-    .unwrap();
-    let decoded: Vec<[f64; 3]> = codes
-        .chunks(3)
-        .map(|c| norm([0, 1, 2].map(|i| c[i] as f64 / 255.0 * 2.0 - 1.0)))
-        .collect();
+    let (src, decoded) = normal_png(dir.path(), &n, w, h);
     let out = dir.path().join("n_{level}.png");
     ok(&parvo(&["mip", s(&src), "-o", s(&out), "--normal-map"]));
     for k in 1..=3u32 {
