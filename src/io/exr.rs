@@ -657,7 +657,7 @@ fn choose_channels(
 }
 
 /// Load an EXR file: the first part (or `options.subimage`), all its mip
-/// levels, the channels [`choose_channels`] picks; a data window that is
+/// levels, the channels chosen by OpenImageIO's conventions (see the module docs and `--channels`); a data window that is
 /// not the display window is placed in the display window, black outside
 /// (as maketx pads it), what lies outside is cropped, and a note says so.
 pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Result<Loaded> {
