@@ -25,8 +25,8 @@ use std::hint::black_box;
 use std::sync::Arc;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use parvo::sample::plane::GroundPlane;
 use parvo::sample::{LinearChain, Query, Sampler, SamplerOptions, TexelCounter, TexelSink};
+use parvo::scene::{Frame, Plane, RasterOrder, Scene};
 use parvo::texel::{ChannelType, ColorSpace, Format};
 use parvo::{MipOptions, builtin, mip};
 
@@ -65,15 +65,16 @@ fn incache() -> Vec<Query> {
 }
 
 fn grazing() -> Vec<Query> {
-    GroundPlane {
-        width: 256,
-        height: 256,
+    Scene::Plane(Plane {
         pitch: 10f64.to_radians(),
         uv_per_unit: 0.05,
         max_distance: 60.0,
-        ..Default::default()
-    }
-    .queries()
+        ..Plane::default()
+    })
+    .queries(Frame::new(256, 256), (SIZE, SIZE), RasterOrder::Scanline)
+    .into_iter()
+    .map(|(_, q)| q)
+    .collect()
 }
 
 fn chains() -> (Arc<LinearChain>, Arc<LinearChain>) {

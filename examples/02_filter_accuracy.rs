@@ -6,7 +6,7 @@
 //! cargo run --release --example 02_filter_accuracy
 //! ```
 //!
-//! Scene: `GroundPlane` 15° below the horizon, 256 × 192 pixels, built-in
+//! Scene: the ground `plane` 15° below the horizon, 256 × 192 pixels, built-in
 //! checker and zone plate of 256², box mips, repeat wrapping. Only pixels
 //! whose footprint is at most 32 texels long are scored: the reference
 //! (64 × 64 bilinear lookups over the footprint parallelogram, cells of at
@@ -21,8 +21,9 @@
 //! plate) and loses on sharp edges (the checker); `tests/sample_accuracy.rs`
 //! asserts the zone-plate win on this scene and documents the checker.
 
-use parvo::sample::plane::{GroundPlane, rmse};
 use parvo::sample::{Query, Sampler, SamplerOptions, footprint};
+use parvo::scene::metrics::rmse;
+use parvo::scene::{Frame, Plane, RasterOrder, Scene};
 use parvo::{MipOptions, builtin, mip};
 
 /// Longest footprint (level-0 texels) the 64×64 reference resolves (cells
@@ -30,18 +31,18 @@ use parvo::{MipOptions, builtin, mip};
 const MAX_RHO: f64 = 32.0;
 
 fn scene(w: u32, h: u32) -> Vec<Query> {
-    let plane = GroundPlane {
-        width: w,
-        height: h,
+    let plane = Scene::Plane(Plane {
         pitch: 15f64.to_radians(),
         fov_y: 60f64.to_radians(),
         uv_per_unit: 0.25,
         max_distance: 1e9,
-    };
+        ..Plane::default()
+    });
     let t = SamplerOptions::trilinear();
     plane
-        .queries()
+        .queries(Frame::new(w, h), (256, 256), RasterOrder::Scanline)
         .into_iter()
+        .map(|(_, q)| q)
         .filter(|q| {
             let fp = footprint(q, 256, 256, &t);
             fp.rho_x.max(fp.rho_y) <= MAX_RHO

@@ -53,6 +53,7 @@
 #![warn(missing_docs)]
 
 pub mod builtin;
+pub mod cache;
 pub mod compress;
 mod cpu;
 pub mod error;
@@ -61,6 +62,7 @@ mod mem;
 pub mod mip;
 pub mod sample;
 pub mod sat;
+pub mod scene;
 pub mod texel;
 pub mod texture;
 pub mod wrap;

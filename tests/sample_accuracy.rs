@@ -20,25 +20,26 @@
 //! edges and pays where aliasing dominates (the zone plate). At a coarser
 //! scene (96 × 72 pixels) EWA loses to anisotropic 16 on both textures.
 
-use parvo::sample::plane::{GroundPlane, rmse};
 use parvo::sample::{Query, Sampler, SamplerOptions, footprint};
+use parvo::scene::metrics::rmse;
+use parvo::scene::{Frame, Plane, RasterOrder, Scene};
 use parvo::{MipOptions, builtin, mip};
 
 const MAX_RHO: f64 = 32.0;
 
 fn scene(w: u32, h: u32) -> Vec<Query> {
-    let plane = GroundPlane {
-        width: w,
-        height: h,
+    let plane = Scene::Plane(Plane {
         pitch: 15f64.to_radians(),
         fov_y: 60f64.to_radians(),
         uv_per_unit: 0.25,
         max_distance: 1e9,
-    };
+        ..Plane::default()
+    });
     let t = SamplerOptions::trilinear();
     plane
-        .queries()
+        .queries(Frame::new(w, h), (256, 256), RasterOrder::Scanline)
         .into_iter()
+        .map(|(_, q)| q)
         .filter(|q| {
             let fp = footprint(q, 256, 256, &t);
             fp.rho_x.max(fp.rho_y) <= MAX_RHO

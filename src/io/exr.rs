@@ -3,8 +3,13 @@
 //!
 //! Reading goes through the `exr` crate after the header has been checked
 //! against [`Limits`] (the declared size of every level the file holds).
-//! Channels: `R,G,B[,A]` (also with a layer prefix such as `diffuse.R`),
-//! `Y[,A]` (grey), or any one channel. Half files load as f16, everything
+//! Channels follow OpenImageIO's conventions: ordered by layer, then
+//! `R, G, B, Y, A, …` (`X, Y, Z` in a layer that has them), all of them
+//! when there are at most four, else the first layer's `R,G,B[,A]` or
+//! `Y[,A]`; alpha only when named `A` and last of two or four, other
+//! names are data channels; [`super::LoadOptions::channels`] picks by name.
+//! A multi-part file reads part 0 (or [`super::LoadOptions::subimage`]),
+//! a data window inside a larger display window is placed in it. Half files load as f16, everything
 //! else (float, uint) as f32. EXR data is linear light with premultiplied
 //! (associated) alpha, as the OpenEXR documentation defines it; [`save`]
 //! expects premultiplied levels too (the CLI premultiplies straight
@@ -657,7 +662,7 @@ fn choose_channels(
 }
 
 /// Load an EXR file: the first part (or `options.subimage`), all its mip
-/// levels, the channels chosen by OpenImageIO's conventions (see the module docs and `--channels`); a data window that is
+/// levels, the channels chosen as the module docs say; a data window that is
 /// not the display window is placed in the display window, black outside
 /// (as maketx pads it), what lies outside is cropped, and a note says so.
 pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Result<Loaded> {

@@ -25,8 +25,6 @@
 //!   for bit to the portable code ([`Sampler::uses_simd`]; `PARVO_NO_AVX=1`
 //!   turns it off).
 //! - `batch`: slices of queries, serial or in parallel (rayon).
-//! - [`plane`]: perspective ground-plane queries, the scene the accuracy
-//!   tests, benchmarks and examples share.
 //!
 //! # Speed
 //! The choices that do not change per query — storage, filters, mip mode,
@@ -83,7 +81,6 @@ mod bilinear;
 pub mod ewa;
 pub mod fetch;
 pub mod footprint;
-pub mod plane;
 mod query;
 #[cfg(target_arch = "x86_64")]
 mod simd;
@@ -687,10 +684,10 @@ impl Sampler {
             Kernel::Supersample => each(queries, out, |q| {
                 supersample::supersample(c, a, lod, o, q, sink)
             }),
-            // The table answers from four corner entries per rectangle, not
-            // from texels, so nothing is reported to the sink.
+            // The table answers from corner entries per rectangle, not
+            // from texels: the sink sees those entries.
             Kernel::Sat => each(queries, out, |q| match &self.sat {
-                Some(t) => t.sample(q.u, q.v, q.dudx, q.dvdx, q.dudy, q.dvdy),
+                Some(t) => t.sample_traced(q.u, q.v, q.dudx, q.dvdx, q.dudy, q.dvdy, &mut *sink),
                 None => [0.0; 4],
             }),
         }

@@ -18,6 +18,11 @@ pub trait TexelSink {
     const TRACES: bool = true;
     /// Texel `(x, y)` of mip level `level` was read (`x`, `y` in range).
     fn texel(&mut self, level: u32, x: u32, y: u32);
+    /// Entry `(x, y)` of the summed-area table was read (0 ≤ x ≤ width,
+    /// 0 ≤ y ≤ height: the table has one more row and column than the
+    /// level). Default: ignored.
+    #[inline(always)]
+    fn sat_entry(&mut self, _x: u32, _y: u32) {}
 }
 
 impl<S: TexelSink + ?Sized> TexelSink for &mut S {
@@ -25,6 +30,10 @@ impl<S: TexelSink + ?Sized> TexelSink for &mut S {
     #[inline(always)]
     fn texel(&mut self, level: u32, x: u32, y: u32) {
         (**self).texel(level, x, y);
+    }
+    #[inline(always)]
+    fn sat_entry(&mut self, x: u32, y: u32) {
+        (**self).sat_entry(x, y);
     }
 }
 

@@ -295,6 +295,28 @@ impl AnySat {
     pub fn finish(&self, s: &BoxSum, border: [f32; 4]) -> [f32; 4] {
         dispatch!(self, t => t.finish(s, border))
     }
+    /// Bytes of one entry (all channels), as the cache model reads it.
+    pub fn entry_bytes(&self) -> u64 {
+        let per = match self.kind() {
+            AccumulatorKind::U32 | AccumulatorKind::F32 | AccumulatorKind::OffsetF32 => 4,
+            AccumulatorKind::U64 | AccumulatorKind::F64 => 8,
+            AccumulatorKind::U128 => 16,
+        };
+        per * self.channels() as u64
+    }
+    /// Call `read(x, y)` for every table entry [`Self::average`] reads for
+    /// `rect` under `wrap` (four corners for a rectangle inside the level;
+    /// more where repeat or mirror split it), in the order it reads them.
+    pub fn entries_read(&self, rect: Rect, wrap: Wrap, read: &mut dyn FnMut(u32, u32)) {
+        let r = rect.widened().sanitized();
+        let ax = axis::Axis::new(wrap.u, r.x0, r.x1, self.width());
+        let ay = axis::Axis::new(wrap.v, r.y0, r.y1, self.height());
+        for (iy, _) in ay.terms() {
+            for (ix, _) in ax.terms() {
+                read(ix, iy);
+            }
+        }
+    }
     /// See [`SummedAreaTable::average`].
     pub fn average(&self, rect: Rect, wrap: Wrap, border: [f32; 4]) -> [f32; 4] {
         dispatch!(self, t => t.average(rect, wrap, border))

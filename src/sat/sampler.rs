@@ -11,6 +11,7 @@
 
 use super::{AccumulatorKind, AnySat, BoxSum, COORD_LIMIT, Rect, build};
 use crate::error::Result;
+use crate::sample::TexelSink;
 use crate::texture::{Texture, expand_to_rgba};
 use crate::wrap::Wrap;
 
@@ -118,7 +119,28 @@ impl SatSampler {
     /// than the texture cost what small ones do: whole periods are counted,
     /// not visited.
     pub fn sample(&self, u: f32, v: f32, dudx: f32, dvdx: f32, dudy: f32, dvdy: f32) -> [f32; 4] {
+        self.sample_traced(u, v, dudx, dvdx, dudy, dvdy, &mut crate::sample::NoTrace)
+    }
+
+    /// [`Self::sample`], reporting every table entry it reads to `sink`
+    /// ([`TexelSink::sat_entry`]; four corners per rectangle inside the
+    /// level), so the cache model sees the table as memory.
+    #[allow(clippy::too_many_arguments)] // `sample`'s query plus the sink
+    pub fn sample_traced<S: TexelSink>(
+        &self,
+        u: f32,
+        v: f32,
+        dudx: f32,
+        dvdx: f32,
+        dudy: f32,
+        dvdy: f32,
+        sink: &mut S,
+    ) -> [f32; 4] {
         let r = self.footprint_box(u, v, dudx, dvdx, dudy, dvdy);
+        if S::TRACES {
+            self.table
+                .entries_read(r, self.wrap, &mut |x, y| sink.sat_entry(x, y));
+        }
         let avg = self.table.average(r, self.wrap, self.border);
         expand_to_rgba(&avg[..self.channels])
     }

@@ -1,0 +1,360 @@
+//! Texel memory layouts: the byte address of texel (level, x, y) of a whole
+//! mip chain in one address space (SPEC.md, "Texel memory layouts").
+//!
+//! Levels lie one after another, each starting at a multiple of 4096 bytes;
+//! a texel takes `channels × bytes per channel`, three channels padded to
+//! four as GPUs store them. Within a level:
+//! - `linear`: `(y·w + x)·b`;
+//! - `tiled:TWxTH`: whole tiles in row-major order, row-major inside;
+//! - `morton`: the Z-order index of (x, y), x in the even bits, over the
+//!   power-of-two square holding the level; `morton:TWxTH` is tiled with
+//!   Morton order inside each (power-of-two) tile;
+//! - `blocked:TWxTH:SWxSH`: super-tiles of SW×SH texels made of TW×TH
+//!   tiles (Hakura & Gupta's "6D" blocking), each level row-major.
+//!
+//! [`ChainLayout::address`] is a pure function; every layout maps the
+//! texels of a chain to distinct, non-overlapping byte ranges inside
+//! [`ChainLayout::total_bytes`] (tested for odd and non-square sizes). A
+//! summed-area table is a region of its own after the chain
+//! ([`ChainLayout::with_sat`]): entries row-major, entry size = channels ×
+//! accumulator bytes.
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+use crate::scene::order::interleave;
+
+/// Alignment of every level (and of the summed-area table).
+pub const LEVEL_ALIGN: u64 = 4096;
+
+/// A texel memory layout (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Layout {
+    /// Row-major.
+    #[default]
+    Linear,
+    /// Row-major tiles of `tw × th` texels, row-major inside.
+    Tiled {
+        /// Tile width.
+        tw: u32,
+        /// Tile height.
+        th: u32,
+    },
+    /// Z-order over the power-of-two square holding the level.
+    Morton,
+    /// Row-major tiles, Z-order inside each (power-of-two) tile.
+    MortonTiled {
+        /// Tile width (a power of two).
+        tw: u32,
+        /// Tile height (a power of two).
+        th: u32,
+    },
+    /// Super-tiles of `sw × sh` texels made of `tw × th` tiles.
+    Blocked {
+        /// Tile width.
+        tw: u32,
+        /// Tile height.
+        th: u32,
+        /// Super-tile width (a multiple of `tw`).
+        sw: u32,
+        /// Super-tile height (a multiple of `th`).
+        sh: u32,
+    },
+}
+
+impl fmt::Display for Layout {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Layout::Linear => f.write_str("linear"),
+            Layout::Tiled { tw, th } => write!(f, "tiled:{tw}x{th}"),
+            Layout::Morton => f.write_str("morton"),
+            Layout::MortonTiled { tw, th } => write!(f, "morton:{tw}x{th}"),
+            Layout::Blocked { tw, th, sw, sh } => write!(f, "blocked:{tw}x{th}:{sw}x{sh}"),
+        }
+    }
+}
+
+fn dims(what: &'static str, s: &str, t: &str) -> Result<(u32, u32)> {
+    let bad = || {
+        Error::parse(
+            what,
+            s,
+            format!("`{t}` is not WxH with W and H from 1 to 4096"),
+        )
+    };
+    let (a, b) = t.split_once(['x', 'X']).ok_or_else(bad)?;
+    let p = |v: &str| {
+        v.parse::<u32>()
+            .ok()
+            .filter(|n| (1..=4096).contains(n))
+            .ok_or_else(bad)
+    };
+    Ok((p(a)?, p(b)?))
+}
+
+impl FromStr for Layout {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        let what = "memory layout";
+        let t = s.trim().to_ascii_lowercase();
+        let parts: Vec<&str> = t.split(':').collect();
+        let layout = match parts.as_slice() {
+            ["linear"] => Layout::Linear,
+            ["morton"] => Layout::Morton,
+            ["tiled", d] => {
+                let (tw, th) = dims(what, s, d)?;
+                Layout::Tiled { tw, th }
+            }
+            ["morton", d] => {
+                let (tw, th) = dims(what, s, d)?;
+                if !tw.is_power_of_two() || !th.is_power_of_two() {
+                    return Err(Error::parse(
+                        what,
+                        s,
+                        "morton tiles must be powers of two (Z-order fills a power-of-two tile)",
+                    ));
+                }
+                Layout::MortonTiled { tw, th }
+            }
+            ["blocked", d, e] => {
+                let (tw, th) = dims(what, s, d)?;
+                let (sw, sh) = dims(what, s, e)?;
+                if sw % tw != 0 || sh % th != 0 {
+                    return Err(Error::parse(
+                        what,
+                        s,
+                        "the super-tile must be a whole number of tiles in each direction",
+                    ));
+                }
+                Layout::Blocked { tw, th, sw, sh }
+            }
+            _ => {
+                return Err(Error::parse(
+                    what,
+                    s,
+                    "expected linear, tiled:WxH, morton, morton:WxH or blocked:WxH:SWxSH",
+                ));
+            }
+        };
+        Ok(layout)
+    }
+}
+
+/// Z-order index inside a `tw × th` power-of-two tile: the low bits of x
+/// and y interleaved as far as both reach, then the rest of the longer
+/// side's bits above them.
+fn morton_in_tile(x: u32, y: u32, tw: u32, th: u32) -> u64 {
+    let (bx, by) = (tw.trailing_zeros(), th.trailing_zeros());
+    let k = bx.min(by);
+    let mask = (1u32 << k) - 1;
+    let low = interleave(x & mask, y & mask);
+    let high = if bx > by {
+        (x >> k) as u64
+    } else {
+        (y >> k) as u64
+    };
+    low | (high << (2 * k))
+}
+
+impl Layout {
+    /// Bytes a `w × h` level of `texel`-byte texels occupies, padded as the
+    /// layout pads it.
+    pub fn level_bytes(&self, w: u32, h: u32, texel: u64) -> u64 {
+        let (w, h) = (w as u64, h as u64);
+        let texels = match *self {
+            Layout::Linear => w * h,
+            Layout::Tiled { tw, th } | Layout::MortonTiled { tw, th } => {
+                w.div_ceil(tw as u64) * tw as u64 * h.div_ceil(th as u64) * th as u64
+            }
+            Layout::Morton => {
+                let side = w.max(h).next_power_of_two();
+                side * side
+            }
+            Layout::Blocked { sw, sh, .. } => {
+                w.div_ceil(sw as u64) * sw as u64 * h.div_ceil(sh as u64) * sh as u64
+            }
+        };
+        texels * texel
+    }
+
+    /// Texel offset (in texels) of `(x, y)` inside a level of width `w`.
+    #[inline]
+    pub fn offset(&self, w: u32, x: u32, y: u32) -> u64 {
+        match *self {
+            Layout::Linear => y as u64 * w as u64 + x as u64,
+            Layout::Tiled { tw, th } => {
+                let tiles_x = w.div_ceil(tw) as u64;
+                ((y / th) as u64 * tiles_x + (x / tw) as u64) * (tw as u64 * th as u64)
+                    + (y % th) as u64 * tw as u64
+                    + (x % tw) as u64
+            }
+            Layout::Morton => interleave(x, y),
+            Layout::MortonTiled { tw, th } => {
+                let tiles_x = w.div_ceil(tw) as u64;
+                ((y / th) as u64 * tiles_x + (x / tw) as u64) * (tw as u64 * th as u64)
+                    + morton_in_tile(x % tw, y % th, tw, th)
+            }
+            Layout::Blocked { tw, th, sw, sh } => {
+                let supers_x = w.div_ceil(sw) as u64;
+                let (xs, ys) = (x % sw, y % sh);
+                ((y / sh) as u64 * supers_x + (x / sw) as u64) * (sw as u64 * sh as u64)
+                    + ((ys / th) as u64 * (sw / tw) as u64 + (xs / tw) as u64)
+                        * (tw as u64 * th as u64)
+                    + (ys % th) as u64 * tw as u64
+                    + (xs % tw) as u64
+            }
+        }
+    }
+}
+
+/// A chain's levels (and optionally a summed-area table) in one address
+/// space.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ChainLayout {
+    layout: Layout,
+    texel: u64,
+    /// Per level: width, height, base address.
+    levels: Vec<(u32, u32, u64)>,
+    /// Summed-area table: entries per row, entry bytes, base address.
+    sat: Option<(u64, u64, u64)>,
+    total: u64,
+}
+
+impl ChainLayout {
+    /// The layout of levels of the given sizes (level 0 first) with
+    /// `texel_bytes` per texel (already padded: 3 channels as 4).
+    pub fn new(layout: Layout, sizes: &[(u32, u32)], texel_bytes: u64) -> Self {
+        let mut at = 0u64;
+        let mut levels = Vec::with_capacity(sizes.len());
+        for &(w, h) in sizes {
+            levels.push((w, h, at));
+            at = (at + layout.level_bytes(w, h, texel_bytes)).next_multiple_of(LEVEL_ALIGN);
+        }
+        ChainLayout {
+            layout,
+            texel: texel_bytes,
+            levels,
+            sat: None,
+            total: at,
+        }
+    }
+
+    /// Texel bytes for `channels` channels of `bytes_per_channel` bytes:
+    /// three channels are padded to four.
+    pub fn texel_bytes(channels: u8, bytes_per_channel: usize) -> u64 {
+        let ch = if channels == 3 { 4 } else { channels as u64 };
+        ch * bytes_per_channel as u64
+    }
+
+    /// Add a summed-area table of a `w × h` level-0 after the chain: `(w +
+    /// 1) × (h + 1)` entries of `entry_bytes`, row-major.
+    pub fn with_sat(mut self, w: u32, h: u32, entry_bytes: u64) -> Self {
+        let base = self.total;
+        let row = w as u64 + 1;
+        self.sat = Some((row, entry_bytes, base));
+        self.total = (base + row * (h as u64 + 1) * entry_bytes).next_multiple_of(LEVEL_ALIGN);
+        self
+    }
+
+    /// The layout.
+    pub fn layout(&self) -> Layout {
+        self.layout
+    }
+
+    /// Bytes per texel.
+    pub fn texel(&self) -> u64 {
+        self.texel
+    }
+
+    /// Bytes per summed-area table entry, if the table is laid out.
+    pub fn sat_entry(&self) -> Option<u64> {
+        self.sat.map(|s| s.1)
+    }
+
+    /// Number of levels.
+    pub fn levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// Size of the whole address space (a multiple of 4096).
+    pub fn total_bytes(&self) -> u64 {
+        self.total
+    }
+
+    /// Base address of level `k`.
+    pub fn level_base(&self, k: usize) -> u64 {
+        self.levels[k].2
+    }
+
+    /// Byte address of texel `(x, y)` of level `level` (in range).
+    #[inline]
+    pub fn address(&self, level: u32, x: u32, y: u32) -> u64 {
+        let (w, _, base) = self.levels[level as usize];
+        base + self.layout.offset(w, x, y) * self.texel
+    }
+
+    /// Byte address of summed-area table entry `(x, y)` (0 ≤ x ≤ w,
+    /// 0 ≤ y ≤ h); panics if no table is laid out.
+    #[inline]
+    pub fn sat_address(&self, x: u32, y: u32) -> u64 {
+        let (row, entry, base) = self.sat.expect("no summed-area table in this layout");
+        base + (y as u64 * row + x as u64) * entry
+    }
+
+    /// Which region an address belongs to: `Some(level)` for a texel of
+    /// a level, `None` for the summed-area table or padding past the end.
+    pub fn level_of(&self, address: u64) -> Option<u32> {
+        let k = self.levels.partition_point(|l| l.2 <= address);
+        (k > 0)
+            .then(|| k as u32 - 1)
+            .filter(|&k| self.sat.is_none_or(|s| address < s.2) && (k as usize) < self.levels.len())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_bad_ones_say_why() {
+        for n in [
+            "linear",
+            "tiled:4x4",
+            "tiled:8x2",
+            "morton",
+            "morton:8x4",
+            "blocked:4x4:32x32",
+        ] {
+            assert_eq!(n.parse::<Layout>().unwrap().to_string(), n);
+        }
+        for bad in [
+            "tiled",
+            "tiled:0x4",
+            "morton:3x4",
+            "blocked:4x4:30x32",
+            "zorder",
+        ] {
+            assert!(bad.parse::<Layout>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn spec_formulas_on_hand_worked_texels() {
+        // tiled:4x2, level 10 wide: texel (5, 3) is in tile (1, 1), tiles
+        // per row 3: ((1·3 + 1)·8 + (3 mod 2)·4 + 5 mod 4) = 37.
+        assert_eq!(Layout::Tiled { tw: 4, th: 2 }.offset(10, 5, 3), 37);
+        // morton: (3, 5) → x bits 011 in even, y 101 in odd: 0b100111 = 39.
+        assert_eq!(Layout::Morton.offset(8, 3, 5), 39);
+        // blocked 2x2 tiles in 4x4 super-tiles, level 8 wide: (5, 6) is in
+        // super (1, 1) [2 per row → index 3, ·16 = 48], tile (0, 1) inside
+        // [index 2, ·4 = 8], texel (1, 0) inside [1]: 57.
+        let b = Layout::Blocked {
+            tw: 2,
+            th: 2,
+            sw: 4,
+            sh: 4,
+        };
+        assert_eq!(b.offset(8, 5, 6), 57);
+    }
+}

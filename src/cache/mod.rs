@@ -1,0 +1,19 @@
+//! The texel cache: memory layouts of a chain ([`layout`]), the cache
+//! simulator with its 3C miss classification ([`sim`]) and the plain model
+//! it is tested against ([`reference`]), and the sink that turns a
+//! sampler's texel reads into memory accesses ([`run::AddressSink`]).
+//!
+//! Data flow: a [`crate::scene::Scene`] emits queries in a
+//! [`crate::scene::RasterOrder`]; a sampler filters each and reports every
+//! texel it reads to a [`crate::sample::TexelSink`]; [`run::AddressSink`] maps
+//! (level, x, y) to a byte address with a [`layout::ChainLayout`] and feeds
+//! the [`sim::Simulator`] (or records the addresses as a trace); [`run`]
+//! drives a whole frame.
+
+pub mod layout;
+pub mod reference;
+pub mod run;
+pub mod sim;
+
+pub use layout::{ChainLayout, Layout};
+pub use sim::{AddressSpace, CacheConfig, Counters, Outcome, Policy, Simulator, Stats};

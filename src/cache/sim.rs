@@ -1,0 +1,804 @@
+//! The texel cache simulator (SPEC.md, "Texel cache model").
+//!
+//! A cache of SIZE bytes, lines of L bytes, W ways: `sets = SIZE/(L·W)`,
+//! the line of address `a` is `⌊a/L⌋` and its set `⌊a/L⌋ mod sets`. An
+//! access of B bytes touches lines `⌊a/L⌋ … ⌊(a+B−1)/L⌋`, each counting
+//! one hit or one miss. Replacement is `lru`, `fifo` (hits do not reorder)
+//! or `random` (a seeded xorshift; a new line takes a free way first, then
+//! the way the generator picks). With sectors (`--sector S`) a line is
+//! allocated whole but only the sectors an access touches are fetched; a
+//! touched line whose sectors are all present is a hit.
+//!
+//! Misses are split into three classes (Hill & Smith 1989, Dinero IV's
+//! `-ccc`): cold if what is missing was never accessed before; capacity if
+//! a fully associative LRU cache with the same number of lines (run
+//! alongside, fed every access) also misses; conflict otherwise. The
+//! shadow cache is this same simulator with one set.
+//!
+//! Two stores, chosen by associativity: up to 16 ways, each set's tags sit
+//! in one short array (recency order for LRU, slot order otherwise) and a
+//! lookup is a scan of W tags; above that (fully associative caches, the
+//! 3C shadow) a line → way index (a dense table when the address space is
+//! known, as in scene mode; a hash map for arbitrary traces) and per-set
+//! linked lists make every access O(1). A plain model
+//! ([`super::reference`]) is tested against both, access by access.
+
+use std::collections::HashMap;
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+
+/// Replacement policy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Policy {
+    /// Least recently used.
+    #[default]
+    Lru,
+    /// First in, first out: hits do not reorder.
+    Fifo,
+    /// A seeded pseudo-random way.
+    Random,
+}
+
+impl fmt::Display for Policy {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Policy::Lru => "lru",
+            Policy::Fifo => "fifo",
+            Policy::Random => "random",
+        })
+    }
+}
+
+impl FromStr for Policy {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "lru" => Ok(Policy::Lru),
+            "fifo" => Ok(Policy::Fifo),
+            "random" => Ok(Policy::Random),
+            _ => Err(Error::parse(
+                "replacement policy",
+                s,
+                "expected lru, fifo or random",
+            )),
+        }
+    }
+}
+
+/// Parse a byte size: `16384`, `16K`, `16KiB`, `16KB`, `4M`, `1G`.
+pub fn parse_size(s: &str) -> Result<u64> {
+    let t = s.trim();
+    let bad = || {
+        Error::parse(
+            "byte size",
+            s,
+            "expected a number with an optional K, M or G (16384, 16K, 16KiB, 4M)",
+        )
+    };
+    let lower = t.to_ascii_lowercase();
+    let (num, mul) = [
+        ("kib", 1u64 << 10),
+        ("mib", 1 << 20),
+        ("gib", 1 << 30),
+        ("kb", 1 << 10),
+        ("mb", 1 << 20),
+        ("gb", 1 << 30),
+        ("k", 1 << 10),
+        ("m", 1 << 20),
+        ("g", 1 << 30),
+    ]
+    .iter()
+    .find_map(|(suf, m)| lower.strip_suffix(suf).map(|n| (n.trim().to_string(), *m)))
+    .unwrap_or((lower.clone(), 1));
+    num.parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(mul))
+        .ok_or_else(bad)
+}
+
+/// A cache configuration: `SIZE:LINE:WAYS[:POLICY]`, plus sectors and the
+/// random policy's seed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct CacheConfig {
+    /// Capacity in bytes.
+    pub size: u64,
+    /// Line size in bytes (a power of two).
+    pub line: u64,
+    /// Associativity: 1 direct mapped, `size / line` fully associative.
+    pub ways: u64,
+    /// Replacement policy.
+    pub policy: Policy,
+    /// Sector size in bytes (a power of two dividing the line, at most 32
+    /// sectors per line), or `None` for whole-line fills.
+    pub sector: Option<u64>,
+    /// Seed of the random policy.
+    pub seed: u64,
+}
+
+impl CacheConfig {
+    /// A cache with the given geometry, LRU, no sectors.
+    pub fn new(size: u64, line: u64, ways: u64) -> Self {
+        CacheConfig {
+            size,
+            line,
+            ways,
+            policy: Policy::Lru,
+            sector: None,
+            seed: 0x5eed,
+        }
+    }
+
+    /// Number of lines.
+    pub fn lines(&self) -> u64 {
+        self.size / self.line
+    }
+
+    /// Number of sets.
+    pub fn sets(&self) -> u64 {
+        self.size / (self.line * self.ways)
+    }
+
+    /// The fully associative LRU cache of the same lines (the 3C shadow).
+    pub fn fully_associative(&self) -> Self {
+        CacheConfig {
+            ways: self.lines(),
+            policy: Policy::Lru,
+            ..*self
+        }
+    }
+
+    /// Check the rules a cache must follow; the error names the one broken.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidOption(format!("cache {self}: {m}")));
+        if self.size == 0 || self.line == 0 || self.ways == 0 {
+            return bad("size, line size and ways must all be at least 1".into());
+        }
+        if !self.line.is_power_of_two() {
+            return bad(format!("the line size {} is not a power of two", self.line));
+        }
+        if !self.size.is_multiple_of(self.line * self.ways) {
+            return bad(format!(
+                "the size {} is not a multiple of line × ways = {}",
+                self.size,
+                self.line * self.ways
+            ));
+        }
+        if self.lines() > 1 << 28 {
+            return bad(format!("{} lines is more than 2^28", self.lines()));
+        }
+        if let Some(s) = self.sector
+            && (s == 0
+                || !s.is_power_of_two()
+                || !self.line.is_multiple_of(s)
+                || self.line / s > 32)
+        {
+            return bad(format!(
+                "the sector size {s} must be a power of two dividing the line into at most 32 sectors"
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for CacheConfig {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let size = |n: u64| {
+            if n >= 1 << 20 && n.is_multiple_of(1 << 20) {
+                format!("{}M", n >> 20)
+            } else if n >= 1 << 10 && n.is_multiple_of(1 << 10) {
+                format!("{}K", n >> 10)
+            } else {
+                n.to_string()
+            }
+        };
+        write!(
+            f,
+            "{}:{}:{}:{}",
+            size(self.size),
+            self.line,
+            self.ways,
+            self.policy
+        )?;
+        if let Some(s) = self.sector {
+            write!(f, " (sectors of {s})")?;
+        }
+        Ok(())
+    }
+}
+
+impl FromStr for CacheConfig {
+    type Err = Error;
+    /// `SIZE:LINE:WAYS[:POLICY]`; WAYS may be `full`.
+    fn from_str(s: &str) -> Result<Self> {
+        let parts: Vec<&str> = s.trim().split(':').collect();
+        if !(3..=4).contains(&parts.len()) {
+            return Err(Error::parse(
+                "cache",
+                s,
+                "expected SIZE:LINE:WAYS[:POLICY], e.g. 16K:64:4 or 16K:64:4:fifo",
+            ));
+        }
+        let size = parse_size(parts[0])?;
+        let line = parse_size(parts[1])?;
+        let ways = if parts[2].eq_ignore_ascii_case("full") {
+            size.checked_div(line).unwrap_or(0)
+        } else {
+            parts[2].parse::<u64>().map_err(|_| {
+                Error::parse(
+                    "cache",
+                    s,
+                    format!("ways `{}` is not a number or `full`", parts[2]),
+                )
+            })?
+        };
+        let mut c = CacheConfig::new(size, line, ways);
+        if let Some(p) = parts.get(3) {
+            c.policy = p.parse()?;
+        }
+        c.validate()?;
+        Ok(c)
+    }
+}
+
+/// How a touched line was counted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Outcome {
+    /// Present (with every touched sector).
+    Hit,
+    /// Missing, never accessed before.
+    Cold,
+    /// Missing; a fully associative LRU cache of the same size misses too.
+    Capacity,
+    /// Missing only because of the mapping.
+    Conflict,
+    /// Missing (when misses are not classified).
+    Miss,
+}
+
+/// Counters of a run (or of one mip level of it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Touched lines (one per line an access spans).
+    pub accesses: u64,
+    /// Hits.
+    pub hits: u64,
+    /// Misses.
+    pub misses: u64,
+    /// Cold misses.
+    pub cold: u64,
+    /// Capacity misses.
+    pub capacity: u64,
+    /// Conflict misses.
+    pub conflict: u64,
+    /// Bytes fetched from the next level (lines, or missing sectors).
+    pub bytes_fetched: u64,
+    /// Distinct lines touched (the working set, in lines).
+    pub lines_touched: u64,
+}
+
+impl Counters {
+    /// Hits per access (0 when there were none).
+    pub fn hit_rate(&self) -> f64 {
+        if self.accesses == 0 {
+            0.0
+        } else {
+            self.hits as f64 / self.accesses as f64
+        }
+    }
+
+    fn add(&mut self, o: Outcome, fetched: u64) {
+        self.accesses += 1;
+        match o {
+            Outcome::Hit => self.hits += 1,
+            other => {
+                self.misses += 1;
+                self.bytes_fetched += fetched;
+                match other {
+                    Outcome::Cold => self.cold += 1,
+                    Outcome::Capacity => self.capacity += 1,
+                    Outcome::Conflict => self.conflict += 1,
+                    _ => {}
+                }
+            }
+        }
+    }
+}
+
+/// A fast hasher for line numbers (a multiply and a shift; keys are not
+/// adversarial).
+#[derive(Clone, Copy, Default)]
+struct LineHasher(u64);
+
+impl std::hash::Hasher for LineHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x100_0000_01b3);
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (v ^ (v >> 29))
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .rotate_left(31);
+    }
+}
+
+type LineMap<V> = HashMap<u64, V, std::hash::BuildHasherDefault<LineHasher>>;
+
+/// The lines an address space can hold: dense tables when it is bounded
+/// (scene mode knows it), hash maps for arbitrary traces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AddressSpace {
+    /// Addresses below this many bytes.
+    Bounded(u64),
+    /// Any 64-bit address.
+    Any,
+}
+
+/// line → value, dense or hashed.
+enum Index {
+    Dense(Vec<u32>),
+    Hash(LineMap<u32>),
+}
+
+const NONE: u32 = u32::MAX;
+
+impl Index {
+    fn new(space: AddressSpace, line_shift: u32) -> Self {
+        match space {
+            AddressSpace::Bounded(b) if (b >> line_shift) < (1 << 28) => {
+                Index::Dense(vec![NONE; ((b >> line_shift) + 1) as usize])
+            }
+            _ => Index::Hash(LineMap::default()),
+        }
+    }
+    #[inline]
+    fn get(&self, line: u64) -> u32 {
+        match self {
+            Index::Dense(v) => v.get(line as usize).copied().unwrap_or(NONE),
+            Index::Hash(m) => m.get(&line).copied().unwrap_or(NONE),
+        }
+    }
+    #[inline]
+    fn set(&mut self, line: u64, value: u32) {
+        match self {
+            Index::Dense(v) => {
+                if let Some(x) = v.get_mut(line as usize) {
+                    *x = value;
+                }
+            }
+            Index::Hash(m) => {
+                if value == NONE {
+                    m.remove(&line);
+                } else {
+                    m.insert(line, value);
+                }
+            }
+        }
+    }
+}
+
+const EMPTY: u64 = u64::MAX;
+
+/// One cache level (no classification, no statistics).
+struct Cache {
+    sets: u64,
+    set_mask: Option<u64>,
+    ways: usize,
+    policy: Policy,
+    rng: u64,
+    store: Store,
+}
+
+enum Store {
+    /// Up to 16 ways: per set `ways` tags (LRU: most recent first; others:
+    /// slot order) with their sector masks; `fill` is the number of valid
+    /// ways (and, for FIFO, `ptr` the next victim).
+    Small {
+        tags: Vec<u64>,
+        masks: Vec<u32>,
+        fill: Vec<u8>,
+        ptr: Vec<u8>,
+    },
+    /// More ways: slots `set·ways ..`, a line → slot index, and per set a
+    /// circular list (head = most recent / newest) for LRU and FIFO.
+    Large {
+        index: Index,
+        line: Vec<u64>,
+        mask: Vec<u32>,
+        prev: Vec<u32>,
+        next: Vec<u32>,
+        head: Vec<u32>,
+        fill: Vec<u32>,
+    },
+}
+
+impl Cache {
+    fn new(c: &CacheConfig, space: AddressSpace) -> Self {
+        let sets = c.sets();
+        let ways = c.ways as usize;
+        let slots = c.lines() as usize;
+        let store = if ways <= 16 {
+            Store::Small {
+                tags: vec![EMPTY; slots],
+                masks: vec![0; slots],
+                fill: vec![0; sets as usize],
+                ptr: vec![0; sets as usize],
+            }
+        } else {
+            Store::Large {
+                index: Index::new(space, c.line.trailing_zeros()),
+                line: vec![EMPTY; slots],
+                mask: vec![0; slots],
+                prev: vec![NONE; slots],
+                next: vec![NONE; slots],
+                head: vec![NONE; sets as usize],
+                fill: vec![0; sets as usize],
+            }
+        };
+        Cache {
+            sets,
+            set_mask: sets.is_power_of_two().then(|| sets - 1),
+            ways,
+            policy: c.policy,
+            rng: c.seed | 1,
+            store,
+        }
+    }
+
+    #[inline]
+    fn set_of(&self, line: u64) -> u64 {
+        match self.set_mask {
+            Some(m) => line & m,
+            None => line % self.sets,
+        }
+    }
+
+    /// Touch `line` wanting the sectors in `want`; returns the sectors that
+    /// were missing (0 = hit).
+    #[inline]
+    fn touch(&mut self, line: u64, want: u32) -> u32 {
+        let set = self.set_of(line) as usize;
+        let ways = self.ways;
+        let policy = self.policy;
+        let rng = &mut self.rng;
+        match &mut self.store {
+            Store::Small {
+                tags,
+                masks,
+                fill,
+                ptr,
+            } => {
+                let base = set * ways;
+                let n = fill[set] as usize;
+                let row = &mut tags[base..base + ways];
+                let mrow = &mut masks[base..base + ways];
+                if let Some(i) = row[..n].iter().position(|&t| t == line) {
+                    let missing = want & !mrow[i];
+                    mrow[i] |= want;
+                    if policy == Policy::Lru && i > 0 {
+                        row[..=i].rotate_right(1);
+                        mrow[..=i].rotate_right(1);
+                    }
+                    return missing;
+                }
+                if policy == Policy::Lru {
+                    // Insert as most recent; the last way (least recent)
+                    // falls off when the set is full.
+                    let k = n.min(ways - 1);
+                    row[..=k].rotate_right(1);
+                    mrow[..=k].rotate_right(1);
+                    row[0] = line;
+                    mrow[0] = want;
+                } else {
+                    let slot = if n < ways {
+                        n
+                    } else if policy == Policy::Fifo {
+                        let p = ptr[set] as usize;
+                        ptr[set] = ((p + 1) % ways) as u8;
+                        p
+                    } else {
+                        (xorshift(rng) % ways as u64) as usize
+                    };
+                    row[slot] = line;
+                    mrow[slot] = want;
+                }
+                if n < ways {
+                    fill[set] += 1;
+                }
+                want
+            }
+            Store::Large {
+                index,
+                line: lines,
+                mask,
+                prev,
+                next,
+                head,
+                fill,
+            } => {
+                let s = index.get(line);
+                if s != NONE {
+                    let s = s as usize;
+                    let missing = want & !mask[s];
+                    mask[s] |= want;
+                    if policy == Policy::Lru && head[set] != s as u32 {
+                        unlink(prev, next, head, set, s);
+                        link_head(prev, next, head, set, s);
+                    }
+                    return missing;
+                }
+                let n = fill[set] as usize;
+                let slot = if n < ways {
+                    fill[set] += 1;
+                    set * ways + n
+                } else if policy == Policy::Random {
+                    let victim = set * ways + (xorshift(rng) % ways as u64) as usize;
+                    index.set(lines[victim], NONE);
+                    victim
+                } else {
+                    // The tail (least recent / oldest) is the head's prev.
+                    let victim = prev[head[set] as usize] as usize;
+                    index.set(lines[victim], NONE);
+                    unlink(prev, next, head, set, victim);
+                    victim
+                };
+                lines[slot] = line;
+                mask[slot] = want;
+                index.set(line, slot as u32);
+                if policy != Policy::Random {
+                    link_head(prev, next, head, set, slot);
+                }
+                want
+            }
+        }
+    }
+}
+
+/// xorshift64*: the random policy's generator (the plain model uses the
+/// same one, so both pick the same ways).
+#[inline]
+pub(crate) fn xorshift(state: &mut u64) -> u64 {
+    let mut x = *state;
+    x ^= x >> 12;
+    x ^= x << 25;
+    x ^= x >> 27;
+    *state = x;
+    x.wrapping_mul(0x2545_F491_4F6C_DD1D)
+}
+
+/// Remove slot `s` from set `set`'s circular list.
+#[inline]
+fn unlink(prev: &mut [u32], next: &mut [u32], head: &mut [u32], set: usize, s: usize) {
+    let (p, n) = (prev[s], next[s]);
+    if n as usize == s {
+        head[set] = NONE;
+    } else {
+        next[p as usize] = n;
+        prev[n as usize] = p;
+        if head[set] as usize == s {
+            head[set] = n;
+        }
+    }
+}
+
+/// Put slot `s` at the head of set `set`'s circular list.
+#[inline]
+fn link_head(prev: &mut [u32], next: &mut [u32], head: &mut [u32], set: usize, s: usize) {
+    let h = head[set];
+    if h == NONE {
+        prev[s] = s as u32;
+        next[s] = s as u32;
+    } else {
+        let t = prev[h as usize];
+        next[t as usize] = s as u32;
+        prev[s] = t;
+        next[s] = h;
+        prev[h as usize] = s as u32;
+    }
+    head[set] = s as u32;
+}
+
+/// Lines (and sectors) ever touched: the cold-miss test and the working set.
+enum Touched {
+    Dense(Vec<u32>),
+    Hash(LineMap<u32>),
+}
+
+impl Touched {
+    fn new(space: AddressSpace, line_shift: u32) -> Self {
+        match space {
+            AddressSpace::Bounded(b) if (b >> line_shift) < (1 << 28) => {
+                Touched::Dense(vec![0; ((b >> line_shift) + 1) as usize])
+            }
+            _ => Touched::Hash(LineMap::default()),
+        }
+    }
+    /// Mark `mask`'s sectors of `line`; returns (sectors touched before,
+    /// whether the line is new).
+    #[inline]
+    fn mark(&mut self, line: u64, mask: u32) -> (u32, bool) {
+        let slot = match self {
+            Touched::Dense(v) => match v.get_mut(line as usize) {
+                Some(x) => x,
+                None => return (0, true),
+            },
+            Touched::Hash(m) => m.entry(line).or_insert(0),
+        };
+        let before = *slot;
+        *slot |= mask;
+        (before, before == 0)
+    }
+}
+
+/// Statistics of a simulation.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// First-level totals.
+    pub total: Counters,
+    /// First-level counters per mip level (index = level).
+    pub per_level: Vec<Counters>,
+    /// Second-level totals, when there is one (it sees the first level's
+    /// fetches as reads).
+    pub l2: Option<Counters>,
+}
+
+impl Stats {
+    /// Bytes that reach memory: the last level's fetches.
+    pub fn bytes_from_memory(&self) -> u64 {
+        self.l2.as_ref().unwrap_or(&self.total).bytes_fetched
+    }
+}
+
+/// A cache (with an optional second level) and its statistics.
+pub struct Simulator {
+    l1: Cache,
+    shadow: Option<Cache>,
+    touched: Touched,
+    l2: Option<Cache>,
+    l2_line_shift: u32,
+    l2_sector_shift: u32,
+    l2_sectors: u32,
+    line_shift: u32,
+    sector_shift: u32,
+    sector_bytes: u64,
+    stats: Stats,
+}
+
+impl Simulator {
+    /// A simulator of `l1` (and `l2`) over `space`; `classify` runs the
+    /// fully associative shadow that splits misses into the 3C classes.
+    pub fn new(
+        l1: &CacheConfig,
+        l2: Option<&CacheConfig>,
+        space: AddressSpace,
+        classify: bool,
+    ) -> Result<Self> {
+        l1.validate()?;
+        if let Some(c) = l2 {
+            c.validate()?;
+        }
+        let line_shift = l1.line.trailing_zeros();
+        let sector = l1.sector.unwrap_or(l1.line);
+        Ok(Simulator {
+            l1: Cache::new(l1, space),
+            shadow: classify.then(|| Cache::new(&l1.fully_associative(), space)),
+            touched: Touched::new(space, line_shift),
+            l2: l2.map(|c| Cache::new(c, space)),
+            l2_line_shift: l2.map_or(0, |c| c.line.trailing_zeros()),
+            l2_sector_shift: l2.map_or(0, |c| c.sector.unwrap_or(c.line).trailing_zeros()),
+            l2_sectors: l2.map_or(1, |c| c.sector.map_or(1, |s| (c.line / s) as u32)),
+            line_shift,
+            sector_shift: sector.trailing_zeros(),
+            sector_bytes: sector,
+            stats: Stats {
+                l2: l2.map(|_| Counters::default()),
+                ..Stats::default()
+            },
+        })
+    }
+
+    /// The statistics so far.
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    /// Consume into the statistics.
+    pub fn into_stats(self) -> Stats {
+        self.stats
+    }
+
+    /// An access of `bytes` bytes at `address` (a texel of mip level
+    /// `level`, for the per-level counters).
+    #[inline]
+    pub fn access(&mut self, address: u64, bytes: u64, level: u32) {
+        self.access_with(address, bytes, level, &mut |_, _| {});
+    }
+
+    /// [`Simulator::access`], calling `each(line, outcome)` for every line
+    /// the access touches (tests compare these sequences).
+    #[inline]
+    pub fn access_with(
+        &mut self,
+        address: u64,
+        bytes: u64,
+        level: u32,
+        each: &mut dyn FnMut(u64, Outcome),
+    ) {
+        let bytes = bytes.max(1);
+        let end = address.saturating_add(bytes - 1);
+        let (first, last) = (address >> self.line_shift, end >> self.line_shift);
+        let line_bytes = 1u64 << self.line_shift;
+        for line in first..=last {
+            let lo = address.max(line << self.line_shift) - (line << self.line_shift);
+            let hi =
+                end.min((line << self.line_shift) + line_bytes - 1) - (line << self.line_shift);
+            let (s0, s1) = (lo >> self.sector_shift, hi >> self.sector_shift);
+            let want = (((1u64 << (s1 + 1)) - 1) as u32) & !(((1u64 << s0) - 1) as u32);
+            let missing = self.l1.touch(line, want);
+            let (before, new_line) = self.touched.mark(line, want);
+            let shadow_missing = self.shadow.as_mut().map(|s| s.touch(line, want));
+            let outcome = if missing == 0 {
+                Outcome::Hit
+            } else {
+                match shadow_missing {
+                    None => Outcome::Miss,
+                    Some(_) if missing & before != missing => Outcome::Cold,
+                    Some(0) => Outcome::Conflict,
+                    Some(_) => Outcome::Capacity,
+                }
+            };
+            let fetched = missing.count_ones() as u64 * self.sector_bytes;
+            self.stats.total.add(outcome, fetched);
+            if self.stats.per_level.len() <= level as usize {
+                self.stats
+                    .per_level
+                    .resize(level as usize + 1, Counters::default());
+            }
+            let lv = &mut self.stats.per_level[level as usize];
+            lv.add(outcome, fetched);
+            if new_line {
+                self.stats.total.lines_touched += 1;
+                lv.lines_touched += 1;
+            }
+            if missing != 0 {
+                self.fetch_l2(line, missing);
+            }
+            each(line, outcome);
+        }
+    }
+
+    /// The second level sees each missing sector run of the first as a read.
+    fn fetch_l2(&mut self, line: u64, missing: u32) {
+        let Some(l2) = self.l2.as_mut() else {
+            return;
+        };
+        let c = self.stats.l2.as_mut().expect("l2 counters with l2");
+        let mut m = missing;
+        while m != 0 {
+            let s = m.trailing_zeros() as u64;
+            m &= m - 1;
+            let addr = (line << self.line_shift) + (s << self.sector_shift);
+            let end = addr + self.sector_bytes - 1;
+            for l in (addr >> self.l2_line_shift)..=(end >> self.l2_line_shift) {
+                let base = l << self.l2_line_shift;
+                let lo = addr.max(base) - base;
+                let hi = end.min(base + (1u64 << self.l2_line_shift) - 1) - base;
+                let (s0, s1) = (lo >> self.l2_sector_shift, hi >> self.l2_sector_shift);
+                let want = (((1u64 << (s1 + 1)) - 1) as u32) & !(((1u64 << s0) - 1) as u32);
+                let want = want & (((1u64 << self.l2_sectors) - 1) as u32);
+                let miss = l2.touch(l, want);
+                let o = if miss == 0 {
+                    Outcome::Hit
+                } else {
+                    Outcome::Miss
+                };
+                c.add(o, miss.count_ones() as u64 * (1u64 << self.l2_sector_shift));
+            }
+        }
+    }
+}

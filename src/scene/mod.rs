@@ -1,0 +1,369 @@
+//! Scenes: a W×H frame of pixels mapped to texture coordinates by exact
+//! geometry, turned into per-pixel queries (SPEC.md, "Scenes, raster orders
+//! and the reference image"), and the raster orders that visit the pixels.
+//!
+//! A [`Scene`] is a value with defaults that parses from and prints to its
+//! name: `plane`, `tunnel`, `zoom`, `rotate:DEG[:SCALE]`. Its mapping
+//! ([`Scene::uv`]) takes a continuous screen position in pixels, so the
+//! reference image can integrate the exact mapping over a pixel; its
+//! queries ([`Scene::query`]) take the value at the pixel's centre and the
+//! derivatives as central differences over one pixel (what a rasterizer's
+//! 2×2 quad differences approximate). Scenes whose scale is given in
+//! texels (zoom, rotate) need the level-0 texture size.
+//!
+//! - [`plane`]: a pinhole camera above a textured ground plane (footprints
+//!   grow and stretch towards the horizon);
+//! - [`Tunnel`]: a camera on the axis of a textured cylinder (footprints of
+//!   every orientation around the circle, shrinking into the distance);
+//! - [`Zoom`]: one frame sweeping from 8× magnification at the left edge to
+//!   1/256 minification at the right (λ from −3 to 8);
+//! - [`Rotate`]: a screen-filling texture turned by an angle, a fixed
+//!   number of texels per pixel (λ = log2(scale) everywhere).
+
+pub mod metrics;
+pub mod order;
+pub mod plane;
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+use crate::sample::Query;
+
+pub use order::RasterOrder;
+pub use plane::Plane;
+
+/// A frame size in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Frame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+}
+
+impl Frame {
+    /// A `width × height` frame.
+    pub const fn new(width: u32, height: u32) -> Self {
+        Frame { width, height }
+    }
+
+    /// Number of pixels.
+    pub fn pixels(&self) -> u64 {
+        self.width as u64 * self.height as u64
+    }
+}
+
+impl fmt::Display for Frame {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}x{}", self.width, self.height)
+    }
+}
+
+impl FromStr for Frame {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        let bad = || {
+            Error::parse(
+                "frame size",
+                s,
+                "expected WxH, e.g. 512x384, 1 to 16384 each",
+            )
+        };
+        let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+        let p = |t: &str| {
+            t.trim()
+                .parse::<u32>()
+                .ok()
+                .filter(|n| (1..=16384).contains(n))
+                .ok_or_else(bad)
+        };
+        Ok(Frame::new(p(w)?, p(h)?))
+    }
+}
+
+/// Inside a textured cylinder of radius 1, looking down its axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tunnel {
+    /// Vertical field of view, radians.
+    pub fov_y: f64,
+    /// Texture repeats around the circumference (u).
+    pub repeats_around: f64,
+    /// Texture repeats per unit of depth (v).
+    pub v_per_unit: f64,
+    /// Pixels that see the wall farther than this are skipped.
+    pub max_distance: f64,
+}
+
+impl Default for Tunnel {
+    /// 90° field of view, 2 repeats around, 0.25 per unit, up to 40 deep.
+    fn default() -> Self {
+        Tunnel {
+            fov_y: 90f64.to_radians(),
+            repeats_around: 2.0,
+            v_per_unit: 0.25,
+            max_distance: 40.0,
+        }
+    }
+}
+
+/// Texels per pixel growing exponentially from left to right.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Zoom {
+    /// log2 of level-0 texels per pixel at the left edge (−3: 8×
+    /// magnification).
+    pub lod_left: f64,
+    /// log2 of texels per pixel at the right edge (8: 1/256).
+    pub lod_right: f64,
+}
+
+impl Default for Zoom {
+    fn default() -> Self {
+        Zoom {
+            lod_left: -3.0,
+            lod_right: 8.0,
+        }
+    }
+}
+
+/// A screen-filling texture turned by `degrees`, `scale` level-0 texels
+/// per pixel along each screen axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rotate {
+    /// Angle of the texture's u axis to the screen's x axis, degrees.
+    pub degrees: f64,
+    /// Level-0 texels per pixel along each screen axis (λ = log2 scale).
+    pub scale: f64,
+}
+
+/// The scenes (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Scene {
+    /// A ground plane below a pinhole camera.
+    Plane(Plane),
+    /// Inside a cylinder.
+    Tunnel(Tunnel),
+    /// 8× magnification to 1/256 minification across the frame.
+    Zoom(Zoom),
+    /// A rotated, uniformly scaled texture.
+    Rotate(Rotate),
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene::Plane(Plane::default())
+    }
+}
+
+impl fmt::Display for Scene {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Scene::Plane(_) => f.write_str("plane"),
+            Scene::Tunnel(_) => f.write_str("tunnel"),
+            Scene::Zoom(_) => f.write_str("zoom"),
+            Scene::Rotate(r) if r.scale == 1.0 => write!(f, "rotate:{}", r.degrees),
+            Scene::Rotate(r) => write!(f, "rotate:{}:{}", r.degrees, r.scale),
+        }
+    }
+}
+
+impl FromStr for Scene {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        let expected = "expected plane, tunnel, zoom or rotate:DEG[:SCALE]";
+        let t = s.trim().to_ascii_lowercase();
+        let mut parts = t.split(':');
+        let scene = match parts.next().unwrap_or("") {
+            "plane" => Scene::Plane(Plane::default()),
+            "tunnel" => Scene::Tunnel(Tunnel::default()),
+            "zoom" => Scene::Zoom(Zoom::default()),
+            "rotate" => {
+                let num = |p: Option<&str>, what: &str| -> Result<Option<f64>> {
+                    match p {
+                        None => Ok(None),
+                        Some(v) => v
+                            .parse::<f64>()
+                            .ok()
+                            .filter(|x| x.is_finite())
+                            .map(Some)
+                            .ok_or_else(|| {
+                                Error::parse("scene", s, format!("{what} `{v}` is not a number"))
+                            }),
+                    }
+                };
+                let degrees = num(parts.next(), "angle")?.ok_or_else(|| {
+                    Error::parse("scene", s, "rotate needs an angle: rotate:DEG[:SCALE]")
+                })?;
+                let scale = num(parts.next(), "scale")?.unwrap_or(1.0);
+                if !(scale > 0.0 && scale <= 1e6) {
+                    return Err(Error::parse(
+                        "scene",
+                        s,
+                        "the scale must be above 0 (texels per pixel)",
+                    ));
+                }
+                Scene::Rotate(Rotate { degrees, scale })
+            }
+            _ => return Err(Error::parse("scene", s, expected)),
+        };
+        if parts.next().is_some() {
+            return Err(Error::parse("scene", s, expected));
+        }
+        Ok(scene)
+    }
+}
+
+impl Scene {
+    /// Texture coordinate of the continuous screen position `(x, y)` (in
+    /// pixels, row 0 at the top), for a level-0 texture of `tex` texels;
+    /// `None` where the scene shows no texture.
+    pub fn uv(&self, frame: Frame, tex: (u32, u32), x: f64, y: f64) -> Option<(f64, f64)> {
+        let (w, h) = (frame.width as f64, frame.height as f64);
+        let (tw, th) = (tex.0.max(1) as f64, tex.1.max(1) as f64);
+        match self {
+            Scene::Plane(p) => p.uv(frame, x, y),
+            Scene::Tunnel(t) => {
+                let tan = (t.fov_y * 0.5).tan();
+                let nx = (x / w * 2.0 - 1.0) * tan * (w / h);
+                let ny = (1.0 - y / h * 2.0) * tan;
+                let r = (nx * nx + ny * ny).sqrt();
+                if r < 1e-12 {
+                    return None;
+                }
+                let z = 1.0 / r;
+                if z > t.max_distance {
+                    return None;
+                }
+                let angle = ny.atan2(nx) / std::f64::consts::TAU + 0.5;
+                Some((angle * t.repeats_around, z * t.v_per_unit))
+            }
+            Scene::Zoom(z) => {
+                let k = (z.lod_right - z.lod_left) / w;
+                let s = (z.lod_left + k * x).exp2();
+                let u = if k.abs() < 1e-15 {
+                    s * x
+                } else {
+                    (s - z.lod_left.exp2()) / (k * std::f64::consts::LN_2)
+                };
+                Some((u / tw, 0.5 + (y - h * 0.5) * s / th))
+            }
+            Scene::Rotate(r) => {
+                let (sn, cs) = r.degrees.to_radians().sin_cos();
+                let (dx, dy) = (x - w * 0.5, y - h * 0.5);
+                Some((
+                    0.5 + (cs * dx - sn * dy) * r.scale / tw,
+                    0.5 + (sn * dx + cs * dy) * r.scale / th,
+                ))
+            }
+        }
+    }
+
+    /// The query of pixel `(px, py)`: the coordinate at its centre and the
+    /// central differences over one pixel, or `None` if the centre or a
+    /// half-pixel neighbour shows no texture.
+    pub fn query(&self, frame: Frame, tex: (u32, u32), px: u32, py: u32) -> Option<Query> {
+        let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
+        let at = |x: f64, y: f64| self.uv(frame, tex, x, y);
+        let c = at(x, y)?;
+        let (l, r) = (at(x - 0.5, y)?, at(x + 0.5, y)?);
+        let (t, b) = (at(x, y - 0.5)?, at(x, y + 0.5)?);
+        // The tunnel's u wraps around the circle: difference across the
+        // seam by the short way.
+        let period = match self {
+            Scene::Tunnel(t) => Some(t.repeats_around),
+            _ => None,
+        };
+        let d = |a: f64, b: f64| match period {
+            Some(p) => {
+                let mut v = b - a;
+                v -= (v / p).round() * p;
+                v
+            }
+            None => b - a,
+        };
+        Some(Query::new(
+            c.0 as f32,
+            c.1 as f32,
+            d(l.0, r.0) as f32,
+            (r.1 - l.1) as f32,
+            d(t.0, b.0) as f32,
+            (b.1 - t.1) as f32,
+        ))
+    }
+
+    /// Every pixel that shows texture, in `order`, with its query.
+    pub fn queries(
+        &self,
+        frame: Frame,
+        tex: (u32, u32),
+        order: RasterOrder,
+    ) -> Vec<((u32, u32), Query)> {
+        order
+            .pixels(frame)
+            .filter_map(|(px, py)| self.query(frame, tex, px, py).map(|q| ((px, py), q)))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_bad_names_are_errors() {
+        for n in ["plane", "tunnel", "zoom", "rotate:30", "rotate:12.5:4"] {
+            assert_eq!(n.parse::<Scene>().unwrap().to_string(), n);
+        }
+        for bad in ["", "rotate", "rotate:x", "rotate:30:0", "plane:3", "cube"] {
+            assert!(bad.parse::<Scene>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn rotate_has_its_scale_in_texels_per_pixel_everywhere() {
+        let s: Scene = "rotate:30:4".parse().unwrap();
+        let f = Frame::new(33, 17);
+        for (px, py) in [(0, 0), (16, 8), (32, 16)] {
+            let q = s.query(f, (256, 128), px, py).unwrap();
+            let ax = ((q.dudx * 256.0).hypot(q.dvdx * 128.0)) as f64;
+            let ay = ((q.dudy * 256.0).hypot(q.dvdy * 128.0)) as f64;
+            assert!(
+                (ax - 4.0).abs() < 1e-4 && (ay - 4.0).abs() < 1e-4,
+                "{ax} {ay}"
+            );
+        }
+    }
+
+    #[test]
+    fn zoom_spans_eight_times_magnification_to_one_256th() {
+        let s = Scene::Zoom(Zoom::default());
+        let f = Frame::new(1100, 64);
+        let rho = |px: u32| {
+            let q = s.query(f, (512, 512), px, 32).unwrap();
+            (q.dudx as f64 * 512.0).hypot(q.dvdx as f64 * 512.0)
+        };
+        assert!((rho(0).log2() + 3.0).abs() < 0.01, "{}", rho(0).log2());
+        assert!(
+            (rho(1099).log2() - 8.0).abs() < 0.01,
+            "{}",
+            rho(1099).log2()
+        );
+    }
+
+    #[test]
+    fn tunnel_differences_cross_the_seam_the_short_way() {
+        let s = Scene::Tunnel(Tunnel::default());
+        let f = Frame::new(64, 64);
+        // Left of the centre, the seam (angle ±π) runs along the row.
+        for py in 0..64 {
+            for px in 0..64 {
+                if let Some(q) = s.query(f, (64, 64), px, py) {
+                    assert!(
+                        q.dudx.abs() < 0.5 && q.dudy.abs() < 0.5,
+                        "({px}, {py}): {q:?}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,194 @@
+//! Raster orders: the order in which a frame's pixels are filtered (SPEC.md).
+//!
+//! - `scanline`: rows top to bottom, each left to right;
+//! - `tiled:N`: N×N tiles in scanline order of tiles, scanline inside each
+//!   tile, partial tiles at the right and bottom edges;
+//! - `morton`: Z-order of (px, py), px in the even bits, pixels outside the
+//!   frame skipped;
+//! - `hilbert`: the Hilbert curve over the smallest power-of-two square
+//!   holding the frame, pixels outside skipped.
+
+use std::fmt;
+use std::str::FromStr;
+
+use super::Frame;
+use crate::error::{Error, Result};
+
+/// A raster order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum RasterOrder {
+    /// Rows top to bottom.
+    #[default]
+    Scanline,
+    /// N×N-pixel tiles.
+    Tiled(u32),
+    /// Z-order.
+    Morton,
+    /// Hilbert curve.
+    Hilbert,
+}
+
+impl fmt::Display for RasterOrder {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RasterOrder::Scanline => f.write_str("scanline"),
+            RasterOrder::Tiled(n) => write!(f, "tiled:{n}"),
+            RasterOrder::Morton => f.write_str("morton"),
+            RasterOrder::Hilbert => f.write_str("hilbert"),
+        }
+    }
+}
+
+impl FromStr for RasterOrder {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        let t = s.trim().to_ascii_lowercase();
+        Ok(match t.as_str() {
+            "scanline" => RasterOrder::Scanline,
+            "morton" => RasterOrder::Morton,
+            "hilbert" => RasterOrder::Hilbert,
+            _ => match t.strip_prefix("tiled:") {
+                Some(n) => RasterOrder::Tiled(
+                    n.parse::<u32>()
+                        .ok()
+                        .filter(|&n| (1..=4096).contains(&n))
+                        .ok_or_else(|| {
+                            Error::parse("raster order", s, "tiled:N needs N from 1 to 4096")
+                        })?,
+                ),
+                None => {
+                    return Err(Error::parse(
+                        "raster order",
+                        s,
+                        "expected scanline, tiled:N, morton or hilbert",
+                    ));
+                }
+            },
+        })
+    }
+}
+
+/// x in the even bits, y in the odd bits (16 bits each).
+pub(crate) fn interleave(x: u32, y: u32) -> u64 {
+    fn spread(v: u32) -> u64 {
+        let mut v = v as u64 & 0xffff_ffff;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        v = (v | (v << 1)) & 0x5555_5555_5555_5555;
+        v
+    }
+    spread(x) | (spread(y) << 1)
+}
+
+fn compact(v: u64) -> u32 {
+    let mut v = v & 0x5555_5555_5555_5555;
+    v = (v | (v >> 1)) & 0x3333_3333_3333_3333;
+    v = (v | (v >> 2)) & 0x0f0f_0f0f_0f0f_0f0f;
+    v = (v | (v >> 4)) & 0x00ff_00ff_00ff_00ff;
+    v = (v | (v >> 8)) & 0x0000_ffff_0000_ffff;
+    v = (v | (v >> 16)) & 0x0000_0000_ffff_ffff;
+    v as u32
+}
+
+/// Position `d` along the Hilbert curve of an `n × n` square (n a power of
+/// two), the classic `d2xy`.
+fn hilbert_d2xy(n: u64, d: u64) -> (u32, u32) {
+    let (mut x, mut y) = (0u64, 0u64);
+    let mut t = d;
+    let mut s = 1u64;
+    while s < n {
+        let rx = 1 & (t / 2);
+        let ry = 1 & (t ^ rx);
+        if ry == 0 {
+            if rx == 1 {
+                x = s - 1 - x;
+                y = s - 1 - y;
+            }
+            std::mem::swap(&mut x, &mut y);
+        }
+        x += s * rx;
+        y += s * ry;
+        t /= 4;
+        s *= 2;
+    }
+    (x as u32, y as u32)
+}
+
+impl RasterOrder {
+    /// Every pixel of `frame` exactly once, in this order.
+    pub fn pixels(self, frame: Frame) -> Box<dyn Iterator<Item = (u32, u32)> + Send> {
+        let (w, h) = (frame.width, frame.height);
+        match self {
+            RasterOrder::Scanline => {
+                Box::new((0..h).flat_map(move |y| (0..w).map(move |x| (x, y))))
+            }
+            RasterOrder::Tiled(n) => {
+                let n = n.max(1);
+                Box::new((0..h.div_ceil(n)).flat_map(move |ty| {
+                    (0..w.div_ceil(n)).flat_map(move |tx| {
+                        let (x0, y0) = (tx * n, ty * n);
+                        (y0..(y0 + n).min(h))
+                            .flat_map(move |y| (x0..(x0 + n).min(w)).map(move |x| (x, y)))
+                    })
+                }))
+            }
+            RasterOrder::Morton => {
+                let side = w.max(h).next_power_of_two() as u64;
+                Box::new(
+                    (0..side * side)
+                        .map(|i| (compact(i), compact(i >> 1)))
+                        .filter(move |&(x, y)| x < w && y < h),
+                )
+            }
+            RasterOrder::Hilbert => {
+                let side = w.max(h).next_power_of_two() as u64;
+                Box::new(
+                    (0..side * side)
+                        .map(move |d| hilbert_d2xy(side, d))
+                        .filter(move |&(x, y)| x < w && y < h),
+                )
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for n in ["scanline", "tiled:8", "morton", "hilbert"] {
+            assert_eq!(n.parse::<RasterOrder>().unwrap().to_string(), n);
+        }
+        for bad in ["tiled", "tiled:0", "zigzag"] {
+            assert!(bad.parse::<RasterOrder>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn interleave_puts_x_in_the_even_bits() {
+        assert_eq!(interleave(1, 0), 1);
+        assert_eq!(interleave(0, 1), 2);
+        assert_eq!(interleave(3, 3), 15);
+        assert_eq!(interleave(0xffff, 0), 0x5555_5555);
+        for (x, y) in [(0, 0), (12345, 54321), (65535, 1)] {
+            let i = interleave(x, y);
+            assert_eq!((compact(i), compact(i >> 1)), (x, y));
+        }
+    }
+
+    #[test]
+    fn hilbert_steps_to_a_neighbour_each_time() {
+        let n = 16u64;
+        let mut prev = hilbert_d2xy(n, 0);
+        for d in 1..n * n {
+            let p = hilbert_d2xy(n, d);
+            let dist = prev.0.abs_diff(p.0) + prev.1.abs_diff(p.1);
+            assert_eq!(dist, 1, "d = {d}");
+            prev = p;
+        }
+    }
+}
