@@ -240,6 +240,34 @@ impl ChainLayout {
         }
     }
 
+    /// The layout of `chain`'s levels in its stored format.
+    pub fn of_chain(chain: &crate::MipChain, layout: Layout) -> Self {
+        let f = chain.levels()[0].format();
+        let sizes: Vec<(u32, u32)> = chain
+            .levels()
+            .iter()
+            .map(|l| (l.width(), l.height()))
+            .collect();
+        ChainLayout::new(
+            layout,
+            &sizes,
+            ChainLayout::texel_bytes(f.channels, f.channel_type.bytes()),
+        )
+    }
+
+    /// The layout a sampler reads: `chain`'s levels, and its summed-area
+    /// table after them when the sampler filters with one (`sat`).
+    pub fn for_sampler(chain: &crate::MipChain, sampler: &crate::Sampler, layout: Layout) -> Self {
+        let c = Self::of_chain(chain, layout);
+        match sampler.sat() {
+            Some(s) => {
+                let l0 = &chain.levels()[0];
+                c.with_sat(l0.width(), l0.height(), s.table().entry_bytes())
+            }
+            None => c,
+        }
+    }
+
     /// Texel bytes for `channels` channels of `bytes_per_channel` bytes:
     /// three channels are padded to four.
     pub fn texel_bytes(channels: u8, bytes_per_channel: usize) -> u64 {

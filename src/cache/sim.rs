@@ -459,9 +459,9 @@ impl Cache {
     }
 
     /// Touch `line` wanting the sectors in `want`; returns the sectors that
-    /// were missing (0 = hit).
+    /// were missing (0 = hit) and the line's sectors present afterwards.
     #[inline]
-    fn touch(&mut self, line: u64, want: u32) -> u32 {
+    fn touch(&mut self, line: u64, want: u32) -> (u32, u32) {
         let set = self.set_of(line) as usize;
         let ways = self.ways;
         let policy = self.policy;
@@ -480,20 +480,19 @@ impl Cache {
                 if let Some(i) = row[..n].iter().position(|&t| t == line) {
                     let missing = want & !mrow[i];
                     mrow[i] |= want;
+                    let after = mrow[i];
                     if policy == Policy::Lru && i > 0 {
-                        row[..=i].rotate_right(1);
-                        mrow[..=i].rotate_right(1);
+                        move_to_front(row, mrow, i);
                     }
-                    return missing;
+                    return (missing, after);
                 }
                 if policy == Policy::Lru {
                     // Insert as most recent; the last way (least recent)
                     // falls off when the set is full.
                     let k = n.min(ways - 1);
-                    row[..=k].rotate_right(1);
-                    mrow[..=k].rotate_right(1);
-                    row[0] = line;
-                    mrow[0] = want;
+                    row[k] = line;
+                    mrow[k] = want;
+                    move_to_front(row, mrow, k);
                 } else {
                     let slot = if n < ways {
                         n
@@ -510,7 +509,7 @@ impl Cache {
                 if n < ways {
                     fill[set] += 1;
                 }
-                want
+                (want, want)
             }
             Store::Large {
                 index,
@@ -530,7 +529,7 @@ impl Cache {
                         unlink(prev, next, head, set, s);
                         link_head(prev, next, head, set, s);
                     }
-                    return missing;
+                    return (missing, mask[s]);
                 }
                 let n = fill[set] as usize;
                 let slot = if n < ways {
@@ -553,10 +552,26 @@ impl Cache {
                 if policy != Policy::Random {
                     link_head(prev, next, head, set, slot);
                 }
-                want
+                (want, want)
             }
         }
     }
+}
+
+/// Move way `i` of a short recency-ordered set to the front (an element
+/// loop: `rotate_right` calls `memmove`, which costs more than the move
+/// for at most 16 ways).
+#[inline(always)]
+fn move_to_front(tags: &mut [u64], masks: &mut [u32], i: usize) {
+    let (t, m) = (tags[i], masks[i]);
+    let mut j = i;
+    while j > 0 {
+        tags[j] = tags[j - 1];
+        masks[j] = masks[j - 1];
+        j -= 1;
+    }
+    tags[0] = t;
+    masks[0] = m;
 }
 
 /// xorshift64*: the random policy's generator (the plain model uses the
@@ -667,6 +682,11 @@ pub struct Simulator {
     sector_shift: u32,
     sector_bytes: u64,
     stats: Stats,
+    /// The line of the last access and the sectors it holds in the cache
+    /// and in the shadow: a repeat needing no more is a hit that changes
+    /// no state (it is most recent in both already).
+    last_line: u64,
+    last_mask: u32,
 }
 
 impl Simulator {
@@ -699,29 +719,48 @@ impl Simulator {
                 l2: l2.map(|_| Counters::default()),
                 ..Stats::default()
             },
+            last_line: u64::MAX,
+            last_mask: 0,
         })
     }
 
-    /// The statistics so far.
-    pub fn stats(&self) -> &Stats {
-        &self.stats
+    /// The statistics so far (the hot path counts accesses and misses per
+    /// level only; hits and the totals are filled in here).
+    pub fn stats(&self) -> Stats {
+        let mut s = self.stats.clone();
+        let mut total = Counters::default();
+        for c in &mut s.per_level {
+            c.hits = c.accesses - c.misses;
+            total.accesses += c.accesses;
+            total.hits += c.hits;
+            total.misses += c.misses;
+            total.cold += c.cold;
+            total.capacity += c.capacity;
+            total.conflict += c.conflict;
+            total.bytes_fetched += c.bytes_fetched;
+            total.lines_touched += c.lines_touched;
+        }
+        s.total = total;
+        if let Some(l2) = &mut s.l2 {
+            l2.hits = l2.accesses - l2.misses;
+        }
+        s
     }
 
     /// Consume into the statistics.
     pub fn into_stats(self) -> Stats {
-        self.stats
+        self.stats()
     }
 
     /// An access of `bytes` bytes at `address` (a texel of mip level
     /// `level`, for the per-level counters).
     #[inline]
     pub fn access(&mut self, address: u64, bytes: u64, level: u32) {
-        self.access_with(address, bytes, level, &mut |_, _| {});
+        self.access_inner(address, bytes, level, |_, _| {});
     }
 
     /// [`Simulator::access`], calling `each(line, outcome)` for every line
     /// the access touches (tests compare these sequences).
-    #[inline]
     pub fn access_with(
         &mut self,
         address: u64,
@@ -729,47 +768,72 @@ impl Simulator {
         level: u32,
         each: &mut dyn FnMut(u64, Outcome),
     ) {
-        let bytes = bytes.max(1);
-        let end = address.saturating_add(bytes - 1);
+        self.access_inner(address, bytes, level, each);
+    }
+
+    #[inline(always)]
+    fn access_inner(
+        &mut self,
+        address: u64,
+        bytes: u64,
+        level: u32,
+        mut each: impl FnMut(u64, Outcome),
+    ) {
+        let end = address.saturating_add(bytes.max(1) - 1);
         let (first, last) = (address >> self.line_shift, end >> self.line_shift);
-        let line_bytes = 1u64 << self.line_shift;
+        if (level as usize) >= self.stats.per_level.len() {
+            self.stats
+                .per_level
+                .resize(level as usize + 1, Counters::default());
+        }
+        if first == last && self.sector_shift == self.line_shift {
+            // The common case: one line, no sectors.
+            let o = self.touch_line(first, 1, level);
+            each(first, o);
+            return;
+        }
+        let line_mask = (1u64 << self.line_shift) - 1;
         for line in first..=last {
-            let lo = address.max(line << self.line_shift) - (line << self.line_shift);
-            let hi =
-                end.min((line << self.line_shift) + line_bytes - 1) - (line << self.line_shift);
+            let base = line << self.line_shift;
+            let lo = address.max(base) - base;
+            let hi = end.min(base + line_mask) - base;
             let (s0, s1) = (lo >> self.sector_shift, hi >> self.sector_shift);
             let want = (((1u64 << (s1 + 1)) - 1) as u32) & !(((1u64 << s0) - 1) as u32);
-            let missing = self.l1.touch(line, want);
-            let (before, new_line) = self.touched.mark(line, want);
-            let shadow_missing = self.shadow.as_mut().map(|s| s.touch(line, want));
-            let outcome = if missing == 0 {
-                Outcome::Hit
-            } else {
-                match shadow_missing {
-                    None => Outcome::Miss,
-                    Some(_) if missing & before != missing => Outcome::Cold,
-                    Some(0) => Outcome::Conflict,
-                    Some(_) => Outcome::Capacity,
-                }
-            };
-            let fetched = missing.count_ones() as u64 * self.sector_bytes;
-            self.stats.total.add(outcome, fetched);
-            if self.stats.per_level.len() <= level as usize {
-                self.stats
-                    .per_level
-                    .resize(level as usize + 1, Counters::default());
-            }
-            let lv = &mut self.stats.per_level[level as usize];
-            lv.add(outcome, fetched);
-            if new_line {
-                self.stats.total.lines_touched += 1;
-                lv.lines_touched += 1;
-            }
-            if missing != 0 {
-                self.fetch_l2(line, missing);
-            }
-            each(line, outcome);
+            let o = self.touch_line(line, want, level);
+            each(line, o);
         }
+    }
+
+    #[inline(always)]
+    fn touch_line(&mut self, line: u64, want: u32, level: u32) -> Outcome {
+        if line == self.last_line && want & !self.last_mask == 0 {
+            self.stats.per_level[level as usize].accesses += 1;
+            return Outcome::Hit;
+        }
+        let (missing, held) = self.l1.touch(line, want);
+        let shadow = self.shadow.as_mut().map(|s| s.touch(line, want));
+        self.last_line = line;
+        self.last_mask = held & shadow.map_or(u32::MAX, |s| s.1);
+        if missing == 0 {
+            self.stats.per_level[level as usize].accesses += 1;
+            return Outcome::Hit;
+        }
+        // Only a miss can touch something for the first time.
+        let (before, new_line) = self.touched.mark(line, want);
+        let outcome = match shadow {
+            None => Outcome::Miss,
+            Some(_) if missing & before != missing => Outcome::Cold,
+            Some((0, _)) => Outcome::Conflict,
+            Some(_) => Outcome::Capacity,
+        };
+        let fetched = missing.count_ones() as u64 * self.sector_bytes;
+        let lv = &mut self.stats.per_level[level as usize];
+        lv.add(outcome, fetched);
+        if new_line {
+            lv.lines_touched += 1;
+        }
+        self.fetch_l2(line, missing);
+        outcome
     }
 
     /// The second level sees each missing sector run of the first as a read.
@@ -791,7 +855,7 @@ impl Simulator {
                 let (s0, s1) = (lo >> self.l2_sector_shift, hi >> self.l2_sector_shift);
                 let want = (((1u64 << (s1 + 1)) - 1) as u32) & !(((1u64 << s0) - 1) as u32);
                 let want = want & (((1u64 << self.l2_sectors) - 1) as u32);
-                let miss = l2.touch(l, want);
+                let (miss, _) = l2.touch(l, want);
                 let o = if miss == 0 {
                     Outcome::Hit
                 } else {

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod cachesim;
 mod info;
 mod mip;
 mod sample;
@@ -26,6 +27,8 @@ enum Command {
     Info(info::InfoArgs),
     /// Sample a texture at queries read from stdin.
     Sample(sample::SampleArgs),
+    /// Simulate the texel cache: bytes from memory per layout, cache, order and filter.
+    Cachesim(Box<cachesim::CachesimArgs>),
 }
 
 pub fn main() -> ExitCode {
@@ -34,6 +37,7 @@ pub fn main() -> ExitCode {
         Command::Mip(a) => mip::run(a),
         Command::Info(a) => info::run(a),
         Command::Sample(a) => sample::run(a),
+        Command::Cachesim(a) => cachesim::run(*a),
     };
     match result {
         Ok(code) => code,

@@ -409,6 +409,7 @@ impl SamplerOptions {
             (Linear, Linear, MipMode::Linear, n) if n > 1 => format!("aniso{n}"),
             (Nearest, Nearest, MipMode::Nearest, 1) => "nearest".into(),
             (Linear, Linear, MipMode::Nearest, 1) => "bilinear".into(),
+            (Linear, Linear, MipMode::None, 1) => "bilinear-nomip".into(),
             (Linear, Linear, MipMode::Linear, 1) => "trilinear".into(),
             (mag, min, mip, n) => {
                 let mut s = format!("mag-{mag}-min-{min}-mip-{mip}");
@@ -418,6 +419,29 @@ impl SamplerOptions {
                 s
             }
         }
+    }
+
+    /// The preset a report name names: a filter name (`aniso` meaning
+    /// aniso16), `aniso2` … `aniso16`, or `bilinear-nomip` (bilinear with
+    /// mip mode none: level 0 only).
+    pub fn from_name(name: &str) -> Result<Self> {
+        let t = name.trim().to_ascii_lowercase();
+        if let Some(n) = t.strip_prefix("aniso").filter(|n| !n.is_empty()) {
+            let n: u32 = n
+                .parse()
+                .ok()
+                .filter(|n| (1..=16).contains(n))
+                .ok_or_else(|| Error::parse("filter", name, "anisoN needs N from 1 to 16"))?;
+            return Ok(SamplerOptions::aniso(n));
+        }
+        if t == "bilinear-nomip" {
+            return Ok(SamplerOptions {
+                mip: MipMode::None,
+                ..SamplerOptions::bilinear()
+            });
+        }
+        let f: Filter = t.parse()?;
+        Ok(SamplerOptions::preset(f, 16))
     }
 
     /// Check every field; [`Sampler::new`] calls this.
@@ -554,6 +578,11 @@ impl Sampler {
         let mut s = Self::build(Arc::new(LinearChain::new(chain)), options, sat.is_some())?;
         s.sat = sat;
         Ok(s)
+    }
+
+    /// The summed-area-table sampler of the `sat` filter.
+    pub fn sat(&self) -> Option<&SatSampler> {
+        self.sat.as_deref()
     }
 
     /// A sampler over an already prepared chain.
