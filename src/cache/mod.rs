@@ -1,6 +1,6 @@
 //! The texel cache: memory layouts of a chain ([`layout`]), the cache
 //! simulator with its 3C miss classification ([`sim`]) and the plain model
-//! it is tested against ([`reference`]), and the sink that turns a
+//! it is tested against ([`mod@reference`]), and the sink that turns a
 //! sampler's texel reads into memory accesses ([`run::AddressSink`]).
 //!
 //! Data flow: a [`crate::scene::Scene`] emits queries in a
