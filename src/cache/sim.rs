@@ -460,7 +460,7 @@ impl Cache {
 
     /// Touch `line` wanting the sectors in `want`; returns the sectors that
     /// were missing (0 = hit) and the line's sectors present afterwards.
-    #[inline]
+    #[inline(always)]
     fn touch(&mut self, line: u64, want: u32) -> (u32, u32) {
         let set = self.set_of(line) as usize;
         let ways = self.ways;
@@ -511,50 +511,61 @@ impl Cache {
                 }
                 (want, want)
             }
-            Store::Large {
-                index,
-                line: lines,
-                mask,
-                prev,
-                next,
-                head,
-                fill,
-            } => {
-                let s = index.get(line);
-                if s != NONE {
-                    let s = s as usize;
-                    let missing = want & !mask[s];
-                    mask[s] |= want;
-                    if policy == Policy::Lru && head[set] != s as u32 {
-                        unlink(prev, next, head, set, s);
-                        link_head(prev, next, head, set, s);
-                    }
-                    return (missing, mask[s]);
-                }
-                let n = fill[set] as usize;
-                let slot = if n < ways {
-                    fill[set] += 1;
-                    set * ways + n
-                } else if policy == Policy::Random {
-                    let victim = set * ways + (xorshift(rng) % ways as u64) as usize;
-                    index.set(lines[victim], NONE);
-                    victim
-                } else {
-                    // The tail (least recent / oldest) is the head's prev.
-                    let victim = prev[head[set] as usize] as usize;
-                    index.set(lines[victim], NONE);
-                    unlink(prev, next, head, set, victim);
-                    victim
-                };
-                lines[slot] = line;
-                mask[slot] = want;
-                index.set(line, slot as u32);
-                if policy != Policy::Random {
-                    link_head(prev, next, head, set, slot);
-                }
-                (want, want)
-            }
+            Store::Large { .. } => self.touch_large(line, want, set),
         }
+    }
+    /// [`Cache::touch`] for more than 16 ways (kept out of line: the hot
+    /// small-set path stays small where it is inlined).
+    #[inline(never)]
+    fn touch_large(&mut self, line: u64, want: u32, set: usize) -> (u32, u32) {
+        let ways = self.ways;
+        let policy = self.policy;
+        let rng = &mut self.rng;
+        let Store::Large {
+            index,
+            line: lines,
+            mask,
+            prev,
+            next,
+            head,
+            fill,
+        } = &mut self.store
+        else {
+            unreachable!("touch_large on a small store")
+        };
+        let s = index.get(line);
+        if s != NONE {
+            let s = s as usize;
+            let missing = want & !mask[s];
+            mask[s] |= want;
+            if policy == Policy::Lru && head[set] != s as u32 {
+                unlink(prev, next, head, set, s);
+                link_head(prev, next, head, set, s);
+            }
+            return (missing, mask[s]);
+        }
+        let n = fill[set] as usize;
+        let slot = if n < ways {
+            fill[set] += 1;
+            set * ways + n
+        } else if policy == Policy::Random {
+            let victim = set * ways + (xorshift(rng) % ways as u64) as usize;
+            index.set(lines[victim], NONE);
+            victim
+        } else {
+            // The tail (least recent / oldest) is the head's prev.
+            let victim = prev[head[set] as usize] as usize;
+            index.set(lines[victim], NONE);
+            unlink(prev, next, head, set, victim);
+            victim
+        };
+        lines[slot] = line;
+        mask[slot] = want;
+        index.set(line, slot as u32);
+        if policy != Policy::Random {
+            link_head(prev, next, head, set, slot);
+        }
+        (want, want)
     }
 }
 

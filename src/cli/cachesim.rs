@@ -673,11 +673,23 @@ fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
     let (smin, smax) = sel.iter().fold((u64::MAX, 0), |(a, b), r| {
         (a.min(r.cache.size), b.max(r.cache.size))
     });
-    let bmax = sel
-        .iter()
-        .map(|r| r.run.stats.total.bytes_fetched as f64 / r.run.pixels.max(1) as f64)
-        .fold(0.0, f64::max)
-        * 1.05;
+    // Each panel gets its own range, so small differences stay visible.
+    let range = |f: &str, top: bool| {
+        let ys = sel.iter().filter(|r| r.filter == f).map(|r| {
+            let c = &r.run.stats.total;
+            if top {
+                c.hit_rate()
+            } else {
+                c.bytes_fetched as f64 / r.run.pixels.max(1) as f64
+            }
+        });
+        if top {
+            let lo = ys.fold(1.0, f64::min);
+            ((lo * 20.0).floor() / 20.0).min(0.95)..1.0
+        } else {
+            0.0..(ys.fold(0.0, f64::max) * 1.05).max(1.0)
+        }
+    };
     let w = 420 * filters.len() as u32;
     let mut svg = String::new();
     {
@@ -698,17 +710,14 @@ fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
         for (fi, f) in filters.iter().enumerate() {
             for (panel, top) in [(fi, true), (filters.len() + fi, false)] {
                 let area = &cols[panel];
-                let (ylabel, ymax) = if top {
-                    ("hit rate", 1.0)
-                } else {
-                    ("bytes per pixel", bmax.max(1.0))
-                };
+                let ylabel = if top { "hit rate" } else { "bytes per pixel" };
+                let yrange = range(f, top);
                 let mut chart = ChartBuilder::on(area)
                     .caption(format!("{f}: {ylabel}"), ("sans-serif", 14))
                     .margin(10)
                     .x_label_area_size(35)
                     .y_label_area_size(50)
-                    .build_cartesian_2d((kib(smin)..kib(smax)).log_scale(), 0f64..ymax)
+                    .build_cartesian_2d((kib(smin)..kib(smax)).log_scale(), yrange)
                     .map_err(|e| anyhow!("{e}"))?;
                 chart
                     .configure_mesh()
