@@ -13,6 +13,9 @@
 //!                                                   └──▶ TexelSink (every texel read)
 //!
 //! Texture ──sat::build(accumulator)──▶ SummedAreaTable ──▶ SatSampler
+//!
+//! scene::Scene + RasterOrder ──▶ queries ──▶ Sampler ──TexelSink──▶
+//!     cache::run::AddressSink (cache::layout) ──▶ cache::sim::Simulator ──▶ Stats
 //! ```
 //!
 //! - [`texel`]: formats (1–4 channels; u8, u16, f16, f32; linear or sRGB;
@@ -31,6 +34,12 @@
 //!   [`TexelSink`] that sees every texel read; batch sampling on rayon.
 //! - [`sat`]: summed-area tables with exact integer or bounded-error float
 //!   accumulators, O(1) box sums under every wrap mode, the SAT sampler.
+//! - [`scene`]: scenes (plane, tunnel, zoom, rotate) as exact mappings
+//!   from screen to texture, their per-pixel queries, raster orders,
+//!   accuracy metrics.
+//! - [`cache`]: memory layouts of a chain, the texel cache simulator with
+//!   3C miss classes and its plain reference model, scene runs.
+//! - [`compress`]: GPU block formats (BC1–BC7) and their decoding.
 //! - [`io`]: file formats: loading PNG, JPEG, TIFF, HDR, OpenEXR, KTX2,
 //!   DDS and built-ins with decoder limits, and atomic saving of mip chains
 //!   as tiled mip-mapped EXR, KTX2, DDS or one PNG per level.
