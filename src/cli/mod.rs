@@ -7,9 +7,12 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cachesim;
+mod images;
 mod info;
 mod mip;
+mod render;
 mod sample;
+mod tradeoff;
 
 /// Texture filtering and mipmap processing.
 #[derive(Parser, Debug)]
@@ -29,6 +32,10 @@ enum Command {
     Sample(sample::SampleArgs),
     /// Simulate the texel cache: bytes from memory per layout, cache, order and filter.
     Cachesim(Box<cachesim::CachesimArgs>),
+    /// Render a scene with a filter (or the reference) to a PNG.
+    Render(render::RenderArgs),
+    /// Measure each filter's speed, memory traffic, accuracy and flicker on a scene.
+    Tradeoff(Box<tradeoff::TradeoffArgs>),
 }
 
 pub fn main() -> ExitCode {
@@ -38,6 +45,8 @@ pub fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Cachesim(a) => cachesim::run(*a),
+        Command::Render(a) => render::run(a),
+        Command::Tradeoff(a) => tradeoff::run(*a),
     };
     match result {
         Ok(code) => code,

@@ -580,6 +580,17 @@ impl Sampler {
         Ok(s)
     }
 
+    /// A `sat` sampler over `chain` with an already built table (the
+    /// texture store builds it once for every run that needs it).
+    pub fn with_sat(chain: &MipChain, options: SamplerOptions, sat: Arc<SatSampler>) -> Result<Self> {
+        if options.method != Method::Sat {
+            return Self::new(chain, options);
+        }
+        let mut s = Self::build(Arc::new(LinearChain::new(chain)), options, true)?;
+        s.sat = Some(sat);
+        Ok(s)
+    }
+
     /// The summed-area-table sampler of the `sat` filter.
     pub fn sat(&self) -> Option<&SatSampler> {
         self.sat.as_deref()

@@ -19,3 +19,53 @@ pub fn rmse(reference: &[[f32; 4]], got: &[[f32; 4]]) -> f64 {
         .sum();
     (sum / (3 * n) as f64).sqrt()
 }
+
+/// Accuracy of an image against the reference, over the pixels both have,
+/// in linear light over R, G, B (SPEC.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Scores {
+    /// Root-mean-square error.
+    pub rmse: f64,
+    /// 10·log10(1 / MSE), peak 1 (infinite for identical images).
+    pub psnr_db: f64,
+    /// Largest absolute error of any channel.
+    pub max_error: f64,
+    /// Pixels compared.
+    pub pixels: usize,
+}
+
+/// [`Scores`] of `got` against `reference` (row-major, `None` skipped).
+pub fn scores(reference: &[Option<[f32; 4]>], got: &[Option<[f32; 4]>]) -> Scores {
+    let (mut sum, mut max, mut n) = (0f64, 0f64, 0usize);
+    for (r, g) in reference.iter().zip(got) {
+        if let (Some(r), Some(g)) = (r, g) {
+            for c in 0..3 {
+                let d = (r[c] as f64 - g[c] as f64).abs();
+                sum += d * d;
+                max = max.max(d);
+            }
+            n += 1;
+        }
+    }
+    let mse = if n == 0 { 0.0 } else { sum / (3 * n) as f64 };
+    Scores {
+        rmse: mse.sqrt(),
+        psnr_db: 10.0 * (1.0 / mse).log10(),
+        max_error: max,
+        pixels: n,
+    }
+}
+
+/// RMS over pixels (and R, G, B) of the change between two frames.
+pub fn rms_change(a: &[Option<[f32; 4]>], b: &[Option<[f32; 4]>]) -> f64 {
+    scores(a, b).rmse
+}
+
+/// Flicker (SPEC.md): the RMS change of a filter's image between two
+/// frames a quarter pixel apart, minus the reference's own change.
+pub fn flicker(
+    filter: (&[Option<[f32; 4]>], &[Option<[f32; 4]>]),
+    reference: (&[Option<[f32; 4]>], &[Option<[f32; 4]>]),
+) -> f64 {
+    rms_change(filter.0, filter.1) - rms_change(reference.0, reference.1)
+}

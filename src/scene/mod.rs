@@ -23,6 +23,8 @@
 pub mod metrics;
 pub mod order;
 pub mod plane;
+pub mod reference;
+pub mod render;
 
 use std::fmt;
 use std::str::FromStr;
@@ -32,6 +34,7 @@ use crate::sample::Query;
 
 pub use order::RasterOrder;
 pub use plane::Plane;
+pub use reference::{PixelFilter, Reference};
 
 /// A frame size in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -96,13 +99,13 @@ pub struct Tunnel {
 }
 
 impl Default for Tunnel {
-    /// 90° field of view, 2 repeats around, 0.25 per unit, up to 40 deep.
+    /// 90° field of view, 2 repeats around, 0.25 per unit, up to 12 deep.
     fn default() -> Self {
         Tunnel {
             fov_y: 90f64.to_radians(),
             repeats_around: 2.0,
             v_per_unit: 0.25,
-            max_distance: 40.0,
+            max_distance: 12.0,
         }
     }
 }
@@ -262,7 +265,12 @@ impl Scene {
     /// central differences over one pixel, or `None` if the centre or a
     /// half-pixel neighbour shows no texture.
     pub fn query(&self, frame: Frame, tex: (u32, u32), px: u32, py: u32) -> Option<Query> {
-        let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
+        self.query_at(frame, tex, px as f64 + 0.5, py as f64 + 0.5)
+    }
+
+    /// The query of a pixel centred at `(x, y)` (a pixel's centre plus a
+    /// camera offset, for the flicker metric).
+    pub fn query_at(&self, frame: Frame, tex: (u32, u32), x: f64, y: f64) -> Option<Query> {
         let at = |x: f64, y: f64| self.uv(frame, tex, x, y);
         let c = at(x, y)?;
         let (l, r) = (at(x - 0.5, y)?, at(x + 0.5, y)?);
