@@ -19,6 +19,21 @@
 //!    the result is `Σ w·τ / Σ w`. Because Σ ≥ I the ellipse always
 //!    contains a texel centre, so `Σ w > 0`.
 //!
+//! # Speed
+//! The weights are a degree-6 polynomial of r² (within 1.4·10⁻⁶ of
+//! `exp(−2r²) − exp(−2)`; pbrt uses a 128-entry table for the same
+//! purpose; a table measured slower here), r² is stepped along each run by
+//! its first and second differences; runs go along rows or down columns,
+//! whichever is longer for the ellipse (a grazing plane's ellipses run
+//! along v, and the per-run setup is the cost of short runs); runs that lie
+//! inside the level are read straight from memory (no wrapping per
+//! texel), texels alternating between two sets of `f32` sums; the bounds
+//! of each run are solved eight runs at a time. On CPUs with AVX2 and FMA
+//! the same code is compiled for them with fused multiply-adds (so the
+//! last bits differ from the portable build). [`ewa_exact`] keeps the
+//! plain form (`exp` per texel, every fetch wrapped, `f64` sums): the
+//! reference the tests hold both paths to (within 1e-3).
+//!
 //! # Bounded work
 //! Rows are scanned only over the span where `r² < 1` (solved per row),
 //! so the cost is the ellipse's area, not its bounding box. With λ chosen
@@ -47,8 +62,55 @@ pub const MAX_RADIUS: f64 = 40.0;
 /// Gaussian falloff α of the EWA weight `exp(−α·r²) − exp(−α)`.
 const ALPHA: f64 = 2.0;
 
-/// EWA lookup of `q`.
+/// EWA lookup of `q` (the fast path, see the module docs): the same code
+/// compiled for AVX2 and FMA when the CPU has them (fused multiply-adds
+/// there, so results differ from the portable build in the last bits).
 pub(crate) fn ewa<P: Pixel, S: TexelSink>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    o: &SamplerOptions,
+    q: &Query,
+    sink: &mut S,
+) -> [f32; 4] {
+    #[cfg(target_arch = "x86_64")]
+    if crate::cpu::avx2_fma() {
+        #[allow(unsafe_code)]
+        // SAFETY: `avx2_fma()` checked that the CPU has AVX2 and FMA, the
+        // only features `ewa_avx2` is compiled for.
+        return unsafe { ewa_avx2(c, a, lod, o, q, sink) };
+    }
+    ewa_impl::<P, S, false, false>(c, a, lod, o, q, sink)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn ewa_avx2<P: Pixel, S: TexelSink>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    o: &SamplerOptions,
+    q: &Query,
+    sink: &mut S,
+) -> [f32; 4] {
+    ewa_impl::<P, S, false, true>(c, a, lod, o, q, sink)
+}
+
+/// EWA with the weights computed by `exp` per texel, every fetch wrapped
+/// and `f64` sums: the reference the fast path is tested against.
+pub(crate) fn ewa_exact<P: Pixel, S: TexelSink>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    o: &SamplerOptions,
+    q: &Query,
+    sink: &mut S,
+) -> [f32; 4] {
+    ewa_impl::<P, S, true, false>(c, a, lod, o, q, sink)
+}
+
+#[inline(always)]
+fn ewa_impl<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool>(
     c: &Chain<P>,
     a: &Addressing,
     lod: &Lod,
@@ -68,48 +130,88 @@ pub(crate) fn ewa<P: Pixel, S: TexelSink>(
     let mst = ax * ay + bx * by;
     let mtt = ay * ay + by * by;
     let mean = 0.5 * (mss + mtt);
-    let r = (0.5 * (mss - mtt)).hypot(mst);
-    let major = (mean + r).max(0.0).sqrt();
-    let minor0 = (mean - r).max(0.0).sqrt();
-    // Unit vector of the major axis (any direction when isotropic).
-    let (ex, ey) = if r > 0.0 {
-        let th = 0.5 * (2.0 * mst).atan2(mss - mtt);
-        (th.cos(), th.sin())
+    // (The squares of finite derivatives in texels stay far inside the
+    // f64 range, so plain square roots need no `hypot`.)
+    let hd = 0.5 * (mss - mtt);
+    let r = (hd * hd + mst * mst).sqrt();
+    // Squared semi-axes (the eigenvalues of M) and the major axis
+    // direction as the products of its unit vector's components: the
+    // eigenvector of λ₁ = mean + r, from whichever row of M − λ₁I is the
+    // better conditioned (no trigonometry, no further square roots).
+    let major2 = (mean + r).max(0.0);
+    let minor0_2 = (mean - r).max(0.0);
+    let (exx, eyy, exy) = if r > 0.0 {
+        let (vx, vy) = if mss >= mtt {
+            (hd + r, mst)
+        } else {
+            (mst, r - hd)
+        };
+        let inv = 1.0 / (vx * vx + vy * vy);
+        (vx * vx * inv, vy * vy * inv, vx * vy * inv)
     } else {
-        (1.0, 0.0)
+        (1.0, 0.0, 0.0)
     };
-    let minor = minor0.max(major / o.max_aniso.clamp(1, 16) as f64);
-    let lambda = clamp_lod(log2(minor), o);
+    let aniso = o.max_aniso.clamp(1, 16) as f64;
+    let minor2 = minor0_2.max(major2 / (aniso * aniso));
+    // log2(minor) = log2(minor²) / 2.
+    let lambda = clamp_lod(0.5 * log2(minor2), o);
     let (hi, lo, delta) = if lambda > 0.0 {
         levels_for(lambda, lod.q, o.mip)
     } else {
         (0, 0, 0.0)
     };
+    // The lengthened ellipse's J·Jᵀ = major²·e·eᵀ + minor²·e⊥·e⊥ᵀ.
     let axes = Axes {
-        major,
-        minor,
-        ex,
-        ey,
+        xx: major2 * exx + minor2 * eyy,
+        xy: (major2 - minor2) * exy,
+        yy: major2 * eyy + minor2 * exx,
     };
-    let t = ewa_level(c, hi, a, &axes, u, v, sink);
+    let t = ewa_level::<P, S, EXACT, FMA>(c, hi, a, &axes, u, v, sink);
     if delta > 0.0 && lo != hi {
-        let t2 = ewa_level(c, lo, a, &axes, u, v, sink);
+        let t2 = ewa_level::<P, S, EXACT, FMA>(c, lo, a, &axes, u, v, sink);
         lerp(t, t2, delta)
     } else {
         t
     }
 }
 
-/// The (lengthened) ellipse in level-0 texels: semi-axes and the major
-/// axis direction.
+/// The (lengthened) ellipse in level-0 texels as the symmetric matrix
+/// `J'·J'ᵀ` whose square-root semi-axes it has.
 struct Axes {
-    major: f64,
-    minor: f64,
-    ex: f64,
-    ey: f64,
+    xx: f64,
+    xy: f64,
+    yy: f64,
 }
 
-fn ewa_level<P: Pixel, S: TexelSink>(
+/// `exp(−2x) − exp(−2)` on [0, 1] as a degree-6 polynomial (Chebyshev
+/// interpolation, converted to powers; within 1.4·10⁻⁶ of the formula),
+/// kept above 0 inside the ellipse.
+#[inline(always)]
+fn weight_poly<const FMA: bool>(x: f32) -> f32 {
+    const C: [f32; 7] = [
+        0.864_663_4,
+        -1.999_869_1,
+        1.997_875_8,
+        -1.320_221_6,
+        0.627_286_2,
+        -0.203_470_2,
+        0.033_736_594,
+    ];
+    // Estrin's scheme: three multiply-adds deep instead of six.
+    let x2 = x * x;
+    let p01 = madd::<FMA>(C[1], x, C[0]);
+    let p23 = madd::<FMA>(C[3], x, C[2]);
+    let p45 = madd::<FMA>(C[5], x, C[4]);
+    let p46 = madd::<FMA>(C[6], x2, p45);
+    let p26 = madd::<FMA>(p46, x2, p23);
+    let p = madd::<FMA>(p26, x2, p01);
+    // (A plain comparison: one instruction, where `f32::max` adds NaN
+    // handling this polynomial of a finite r² does not need.)
+    if p > 1e-12 { p } else { 1e-12 }
+}
+
+#[inline(always)]
+fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool>(
     c: &Chain<P>,
     k: usize,
     a: &Addressing,
@@ -127,24 +229,23 @@ fn ewa_level<P: Pixel, S: TexelSink>(
     {
         return l.at(&c.lut, k as u32, 0, 0, sink);
     }
-    // Semi-axis vectors in this level's texels.
-    let (mut p1x, mut p1y) = (axes.major * axes.ex * sx, axes.major * axes.ey * sy);
-    let (mut p2x, mut p2y) = (-axes.minor * axes.ey * sx, axes.minor * axes.ex * sy);
-    let size = (p1x * p1x + p1y * p1y + p2x * p2x + p2y * p2y).sqrt();
-    if size > MAX_RADIUS {
-        let f = MAX_RADIUS / size;
-        p1x *= f;
-        p1y *= f;
-        p2x *= f;
-        p2y *= f;
+    // J'·J'ᵀ in this level's texels; its trace is the sum of the squared
+    // semi-axes.
+    let (mut sxx, mut sxy, mut syy) = (axes.xx * sx * sx, axes.xy * sx * sy, axes.yy * sy * sy);
+    let size2 = sxx + syy;
+    if size2 > MAX_RADIUS * MAX_RADIUS {
+        let f = MAX_RADIUS * MAX_RADIUS / size2;
+        sxx *= f;
+        sxy *= f;
+        syy *= f;
     }
     // Σ = J'J'ᵀ + I (unit reconstruction variance).
-    let css = p1x * p1x + p2x * p2x + 1.0;
-    let cst = p1x * p1y + p2x * p2y;
-    let ctt = p1y * p1y + p2y * p2y + 1.0;
+    let css = sxx + 1.0;
+    let cst = sxy;
+    let ctt = syy + 1.0;
     // SPEC: A = Σtt, B = −2Σst, C = Σss, divided by F = AC − B²/4 = det Σ.
-    let f = css * ctt - cst * cst;
-    let (qa, qb, qc) = (ctt / f, -2.0 * cst / f, css / f);
+    let inv_f = 1.0 / (css * ctt - cst * cst);
+    let (qa, qb, qc) = (ctt * inv_f, -2.0 * cst * inv_f, css * inv_f);
     // Centre in texel-centre coordinates, split into an integer base and
     // a fraction so huge coordinates keep their precision.
     let (ib, fs) = split(u * l.wf - 0.5);
@@ -154,12 +255,247 @@ fn ewa_level<P: Pixel, S: TexelSink>(
     let t_ext = ctt.sqrt();
     let t0 = -fast_floor(t_ext - ft);
     let t1 = fast_floor(ft + t_ext);
+    if EXACT {
+        return exact_rows(l, c, k, a, (qa, qb, qc), (ib, jb), (fs, ft), (t0, t1), sink);
+    }
+    // Scan whichever way gives the longer runs: rows for an ellipse wider
+    // than tall, columns otherwise (the per-run setup is the cost of short
+    // runs; a grazing plane's ellipses run along v).
+    let (acc, wsum) = if css >= ctt {
+        scan::<P, S, false, FMA>(
+            l,
+            c,
+            k,
+            a,
+            (qa, qb, qc),
+            (ib, jb),
+            (fs, ft),
+            ctt.sqrt(),
+            sink,
+        )
+    } else {
+        scan::<P, S, true, FMA>(
+            l,
+            c,
+            k,
+            a,
+            (qc, qb, qa),
+            (jb, ib),
+            (ft, fs),
+            css.sqrt(),
+            sink,
+        )
+    };
+    if wsum > 0.0 {
+        acc.map(|x| x / wsum)
+    } else {
+        // Unreachable in exact arithmetic (the ellipse contains a texel
+        // centre); kept so rounding can never divide by zero.
+        l.fetch(&c.lut, k as u32, ib, jb, a, sink)
+    }
+}
+
+/// Most lines an ellipse crosses in [`scan`]: its extent across runs is
+/// at most `sqrt(MAX_RADIUS² + 1)` either side of the centre.
+const MAX_LINES: usize = 2 * (MAX_RADIUS as usize + 2) + 1;
+
+/// `floor(x)` of a small finite `x` (|x| < 2³¹), in a form that vectorises.
+#[inline(always)]
+fn floor_small<const AVX2: bool>(x: f32) -> f32 {
+    if AVX2 {
+        // One rounding instruction on these CPUs.
+        x.floor()
+    } else {
+        let t = x as i32 as f32;
+        if t > x { t - 1.0 } else { t }
+    }
+}
+
+/// The fast inner loops: runs of the ellipse `qa·s² + qb·s·t + qc·t² < 1`
+/// along the first coordinate (x for rows; with `COLUMNS` the caller has
+/// swapped the roles, so runs go down columns), one run per line of the
+/// second coordinate within `±ext`. Every run's ends and its starting r²
+/// and first difference are solved first, in `f32`, in one loop the
+/// compiler vectorises; then r² is stepped along each run, and runs inside
+/// the level are read without wrapping.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool>(
+    l: &super::fetch::Level<P>,
+    c: &Chain<P>,
+    lv: usize,
+    a: &Addressing,
+    (qa, qb, qc): (f64, f64, f64),
+    (ib, jb): (i64, i64),
+    (fs, ft): (f64, f64),
+    ext: f64,
+    sink: &mut S,
+) -> ([f32; 4], f32) {
+    let (mut a0, mut a1, mut a2, mut a3, mut wsum) = (0f32, 0f32, 0f32, 0f32, 0f32);
+    let (w, h) = (l.w as i64, l.h as i64);
+    // Along a run: s; across runs: t (texel x, y, or y, x with COLUMNS).
+    let (len_s, len_t) = if COLUMNS { (h, w) } else { (w, h) };
+    let t0 = -fast_floor(ext - ft);
+    let t1 = fast_floor(ft + ext);
+    let n = ((t1 - t0 + 1).max(0) as usize).min(MAX_LINES);
+    let (qa, qb, qc, fs) = (qa as f32, qb as f32, qc as f32, fs as f32);
+    let inv2a = 0.5 / qa;
+    let tt0 = (t0 as f64 - ft) as f32;
+    let dd = 2.0 * qa;
+    // Eight lines at a time: their runs solved together (vectorised), then
+    // walked one by one.
+    for base in (0..n).step_by(8) {
+        let mut s0s = [0f32; 8];
+        let mut s1s = [0f32; 8];
+        let mut r2s = [0f32; 8];
+        let mut ds = [0f32; 8];
+        for i in 0..8 {
+            let tt = tt0 + (base + i) as f32;
+            // Solve qa·s² + qb·tt·s + (qc·tt² − 1) < 0 for s.
+            let btt = qb * tt;
+            let ctt = qc * tt * tt;
+            let disc = btt * btt - 4.0 * qa * (ctt - 1.0);
+            let half = disc.max(0.0).sqrt() * inv2a;
+            let centre = fs - btt * inv2a;
+            let s0 = -floor_small::<FMA>(half - centre);
+            let s1 = floor_small::<FMA>(centre + half);
+            // A line the ellipse misses (or one past the last) gets an
+            // empty run.
+            s0s[i] = s0;
+            s1s[i] = if disc > 0.0 && base + i < n {
+                s1
+            } else {
+                s0 - 1.0
+            };
+            // r² at s0 and its first difference; the second is 2·qa.
+            let ss0 = s0 - fs;
+            r2s[i] = qa * ss0 * ss0 + btt * ss0 + ctt;
+            ds[i] = qa * (2.0 * ss0 + 1.0) + btt;
+        }
+        for i in 0..8 {
+            let (s0, s1) = (s0s[i] as i64, s1s[i] as i64);
+            if s1 < s0 {
+                continue;
+            }
+            let (mut r2, mut d) = (r2s[i], ds[i]);
+            let line = jb.saturating_add(t0 + (base + i) as i64);
+            let (x0, x1) = (ib.saturating_add(s0), ib.saturating_add(s1));
+            if (0..len_t).contains(&line) && x0 >= 0 && x1 < len_s {
+                // The whole run lies inside the level: read it directly.
+                let n = (x1 - x0) as usize + 1;
+                let (start, stride) = if COLUMNS {
+                    (line as usize + x0 as usize * w as usize, w as usize)
+                } else {
+                    ((line * w + x0) as usize, 1)
+                };
+                let run = &l.texels[start..=start + (n - 1) * stride];
+                // Tracing sinks hear of each texel with a weight (the same test
+                // as the sum's, on the same stepped r²).
+                let mut hit = |k: usize| {
+                    let x = x0 + k as i64;
+                    let (tx, ty) = if COLUMNS { (line, x) } else { (x, line) };
+                    sink.texel(lv as u32, tx as u32, ty as u32);
+                };
+                let (t, ws) = if stride == 1 {
+                    run_sum::<P, S, FMA>(run.iter(), &c.lut, (r2, d, dd), &mut hit)
+                } else {
+                    let it = run.iter().step_by(stride);
+                    run_sum::<P, S, FMA>(it, &c.lut, (r2, d, dd), &mut hit)
+                };
+                a0 += t[0];
+                a1 += t[1];
+                a2 += t[2];
+                a3 += t[3];
+                wsum += ws;
+            } else {
+                for x in x0..=x1 {
+                    if r2 < 1.0 {
+                        let wt = weight_poly::<FMA>(r2);
+                        let (tx, ty) = if COLUMNS { (line, x) } else { (x, line) };
+                        let tex = l.fetch(&c.lut, lv as u32, tx, ty, a, sink);
+                        a0 += wt * tex[0];
+                        a1 += wt * tex[1];
+                        a2 += wt * tex[2];
+                        a3 += wt * tex[3];
+                        wsum += wt;
+                    }
+                    r2 += d;
+                    d += dd;
+                }
+            }
+        }
+    }
+    ([a0, a1, a2, a3], wsum)
+}
+
+/// `a·b + c`, fused when `FMA` (the caller is compiled for FMA).
+#[inline(always)]
+fn madd<const FMA: bool>(a: f32, b: f32, c: f32) -> f32 {
+    if FMA { a.mul_add(b, c) } else { a * b + c }
+}
+
+/// The weighted sum of one in-level run: r² starts at `r2` and steps by
+/// `d`, which steps by `dd`; texels with r² < 1 count, each reported to
+/// `hit` (by its index in the run) when `S` traces. Local sums, no bounds
+/// checks, weights without branches; texels alternate between two sets of
+/// sums and r² steps two texels at a time, so no chain of dependent
+/// additions is longer than half the run.
+#[inline(always)]
+fn run_sum<'a, P: Pixel + 'a, S: TexelSink, const FMA: bool>(
+    mut texels: impl Iterator<Item = &'a P>,
+    lut: &P::Lut,
+    (mut r2, mut d, dd): (f32, f32, f32),
+    hit: &mut impl FnMut(usize),
+) -> ([f32; 4], f32) {
+    let mut acc = [[0f32; 4]; 2];
+    let mut wsum = [0f32; 2];
+    let (dd2, mut k) = (2.0 * dd, 0);
+    let mut add = |set: usize, k: usize, r2: f32, t: &P| {
+        let inside = r2 < 1.0;
+        if S::TRACES && inside {
+            hit(k);
+        }
+        let wt = if inside { weight_poly::<FMA>(r2) } else { 0.0 };
+        let tex = t.decode(lut);
+        for ch in 0..4 {
+            acc[set][ch] = madd::<FMA>(wt, tex[ch], acc[set][ch]);
+        }
+        wsum[set] += wt;
+    };
+    while let Some(t) = texels.next() {
+        add(0, k, r2, t);
+        let Some(t) = texels.next() else { break };
+        add(1, k + 1, r2 + d, t);
+        // r²(k + 2) = r²(k) + 2·d(k) + dd; d(k + 2) = d(k) + 2·dd.
+        r2 += 2.0 * d + dd;
+        d += dd2;
+        k += 2;
+    }
+    let [x, y] = acc;
+    (
+        [x[0] + y[0], x[1] + y[1], x[2] + y[2], x[3] + y[3]],
+        wsum[0] + wsum[1],
+    )
+}
+
+/// The plain inner loops of [`ewa_exact`].
+#[allow(clippy::too_many_arguments)]
+fn exact_rows<P: Pixel, S: TexelSink>(
+    l: &super::fetch::Level<P>,
+    c: &Chain<P>,
+    k: usize,
+    a: &Addressing,
+    (qa, qb, qc): (f64, f64, f64),
+    (ib, jb): (i64, i64),
+    (fs, ft): (f64, f64),
+    (t0, t1): (i64, i64),
+    sink: &mut S,
+) -> [f32; 4] {
     let e_alpha = (-ALPHA).exp();
     let mut acc = [0.0f64; 4];
     let mut wsum = 0.0f64;
     for jt in t0..=t1 {
         let tt = jt as f64 - ft;
-        // Solve qa·s² + qb·tt·s + (qc·tt² − 1) < 0 for s.
         let centre = -qb * tt / (2.0 * qa);
         let disc = (qb * tt) * (qb * tt) - 4.0 * qa * (qc * tt * tt - 1.0);
         if disc <= 0.0 {

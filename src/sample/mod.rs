@@ -582,7 +582,11 @@ impl Sampler {
 
     /// A `sat` sampler over `chain` with an already built table (the
     /// texture store builds it once for every run that needs it).
-    pub fn with_sat(chain: &MipChain, options: SamplerOptions, sat: Arc<SatSampler>) -> Result<Self> {
+    pub fn with_sat(
+        chain: &MipChain,
+        options: SamplerOptions,
+        sat: Arc<SatSampler>,
+    ) -> Result<Self> {
         if options.method != Method::Sat {
             return Self::new(chain, options);
         }
@@ -690,6 +694,18 @@ impl Sampler {
     #[inline]
     pub fn sample(&self, q: &Query) -> [f32; 4] {
         self.sample_traced(q, &mut NoTrace)
+    }
+
+    /// EWA with exactly computed weights (`exp` per texel, every fetch
+    /// wrapped, `f64` sums): the reference the fast EWA of
+    /// [`Sampler::sample`] is tested against (they agree within 1e-3).
+    /// Uses this sampler's options as the `ewa` preset would.
+    pub fn sample_ewa_exact(&self, q: &Query) -> [f32; 4] {
+        let (a, lod, o) = (&self.addr, &self.lod, &self.options);
+        match &self.chain.store {
+            Store::Rgba8(c) => ewa::ewa_exact(c, a, lod, o, q, &mut NoTrace),
+            Store::F32(c) => ewa::ewa_exact(c, a, lod, o, q, &mut NoTrace),
+        }
     }
 
     /// [`Sampler::sample`], reporting every texel read to `sink`.
