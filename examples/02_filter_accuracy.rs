@@ -1,123 +1,129 @@
-//! Accuracy of each filter against the supersampled reference on a
-//! perspective ground plane, printed as the markdown table the README
-//! shows:
+//! Accuracy of each filter against the reference image, per pixel filter,
+//! printed as the markdown tables the README shows:
 //!
 //! ```text
 //! cargo run --release --example 02_filter_accuracy
 //! ```
 //!
-//! Scene: the ground `plane` 15° below the horizon, 256 × 192 pixels, built-in
-//! checker and zone plate of 256², box mips, repeat wrapping. Only pixels
-//! whose footprint is at most 32 texels long are scored: the reference
-//! (64 × 64 bilinear lookups over the footprint parallelogram, cells of at
-//! most half a texel) resolves those without aliasing itself. Score: RMSE
-//! of linear RGB.
-//!
-//! The reference is a *box* filter over the pixel footprint. EWA's
-//! Gaussian (weight `exp(−2r²) − exp(−2)` out to the ellipse of the
-//! derivative vectors, SPEC.md) is softer: truncated at r = 1 its per-axis
-//! σ is 0.37 of a pixel spacing against the box's 0.29, before the blur of
-//! the mip level it reads. It wins where aliasing dominates (the zone
-//! plate) and loses on sharp edges (the checker); `tests/sample_accuracy.rs`
-//! asserts the zone-plate win on this scene and documents the checker.
+//! Scene: `parvo tradeoff`'s default, the ground plane (`Scene::default()`)
+//! at 320 × 240, the built-in checker and zone plate at 512², box mips,
+//! repeat wrapping. The reference (SPEC.md; `parvo::scene::reference`) is
+//! the scene's exact mapping integrated over the pixel filter, bilinear on
+//! level 0: once with the gaussian pixel filter (σ = 0.5 pixel, the one
+//! EWA's weights assume) and once with the box (the pixel's square, what
+//! footprint assembly approximates). Score: PSNR of linear RGB (peak 1),
+//! over every pixel that shows the texture, and by footprint length.
 
-use parvo::sample::{Query, Sampler, SamplerOptions, footprint};
-use parvo::scene::metrics::rmse;
-use parvo::scene::{Frame, Plane, RasterOrder, Scene};
-use parvo::{MipOptions, builtin, mip};
+use parvo::sample::{SamplerOptions, footprint};
+use parvo::scene::metrics::scores;
+use parvo::scene::reference::{PixelFilter, Reference};
+use parvo::scene::render::{Image, filter_image, queries, reference_image};
+use parvo::scene::{Frame, Scene};
+use parvo::store::TextureStore;
 
-/// Longest footprint (level-0 texels) the 64×64 reference resolves (cells
-/// of at most half a texel).
-const MAX_RHO: f64 = 32.0;
-
-fn scene(w: u32, h: u32) -> Vec<Query> {
-    let plane = Scene::Plane(Plane {
-        pitch: 15f64.to_radians(),
-        fov_y: 60f64.to_radians(),
-        uv_per_unit: 0.25,
-        max_distance: 1e9,
-        ..Plane::default()
-    });
-    let t = SamplerOptions::trilinear();
-    plane
-        .queries(Frame::new(w, h), (256, 256), RasterOrder::Scanline)
-        .into_iter()
-        .map(|(_, q)| q)
-        .filter(|q| {
-            let fp = footprint(q, 256, 256, &t);
-            fp.rho_x.max(fp.rho_y) <= MAX_RHO
-        })
-        .collect()
-}
+const FILTERS: [&str; 9] = [
+    "nearest",
+    "bilinear",
+    "trilinear",
+    "aniso2",
+    "aniso4",
+    "aniso8",
+    "aniso16",
+    "ewa",
+    "sat",
+];
 
 fn main() -> Result<(), parvo::Error> {
-    let queries = scene(256, 192);
-    let filters = [
-        SamplerOptions::nearest(),
-        SamplerOptions::bilinear(),
-        SamplerOptions::trilinear(),
-        SamplerOptions::aniso(2),
-        SamplerOptions::aniso(4),
-        SamplerOptions::aniso(8),
-        SamplerOptions::aniso(16),
-        SamplerOptions::ewa(),
-    ];
-    let textures = ["builtin:checker:256", "builtin:zoneplate:256"];
-    let mut table = vec![vec![0.0f64; textures.len()]; filters.len()];
-    // Per footprint size: bin b holds ρmax in (2^(b−1), 2^b] (bin 0: ≤ 1).
-    let t = SamplerOptions::trilinear();
-    let bins: Vec<usize> = queries
-        .iter()
-        .map(|q| {
-            let fp = footprint(q, 256, 256, &t);
-            fp.rho_x.max(fp.rho_y).log2().ceil().clamp(0.0, 5.0) as usize
-        })
-        .collect();
-    let binned = [2, 6, 7]; // trilinear, aniso16, ewa
-    let mut by_bin = vec![vec![[0.0f64; 6]; binned.len()]; textures.len()];
+    let frame = Frame::new(320, 240);
+    let scene = Scene::default();
+    let textures = ["builtin:checker:512", "builtin:zoneplate:512"];
+    let pixel_filters = [PixelFilter::Gaussian, PixelFilter::Box];
+    // psnr[filter][texture][pixel filter]
+    let mut psnr = vec![[[0f64; 2]; 2]; FILTERS.len()];
+    // Per footprint length: bin b holds ρmax in (2^(b−1), 2^b] (bin 0: ≤ 1,
+    // the last: above 32).
+    const BINS: usize = 7;
+    let binned = ["trilinear", "aniso16", "ewa"];
+    let mut by_bin = vec![vec![[0f64; BINS]; binned.len()]; 2 * textures.len()];
+    let mut counts = [0usize; BINS];
+    let mut pixels = 0;
     for (t, name) in textures.iter().enumerate() {
-        let chain = mip::build(builtin::load(name)?, &MipOptions::default())?;
-        let reference = Sampler::new(&chain, SamplerOptions::supersample(64))?;
-        let mut want = vec![[0f32; 4]; queries.len()];
-        reference.sample_batch(&queries, &mut want)?;
-        for (f, o) in filters.iter().enumerate() {
-            let s = Sampler::from_linear(reference.chain().clone(), *o)?;
-            let mut got = vec![[0f32; 4]; queries.len()];
-            s.sample_batch(&queries, &mut got)?;
-            table[f][t] = rmse(&want, &got);
-            if let Some(k) = binned.iter().position(|&b| b == f) {
-                for (b, row) in by_bin[t][k].iter_mut().enumerate() {
-                    let (w, g): (Vec<_>, Vec<_>) = (0..queries.len())
-                        .filter(|&i| bins[i] == b)
-                        .map(|i| (want[i], got[i]))
-                        .unzip();
-                    *row = rmse(&w, &g);
+        let loaded = parvo::io::load(name, &parvo::io::Limits::default())?;
+        let store = TextureStore::from_levels(loaded.levels, Default::default());
+        let tex = (store.base().width(), store.base().height());
+        let qs = queries(&scene, frame, tex, (0.0, 0.0));
+        let tri = SamplerOptions::trilinear();
+        let bins: Vec<Option<usize>> = qs
+            .iter()
+            .map(|q| {
+                q.map(|q| {
+                    let fp = footprint(&q, tex.0, tex.1, &tri);
+                    (fp.rho_x.max(fp.rho_y).log2().ceil().max(0.0) as usize).min(BINS - 1)
+                })
+            })
+            .collect();
+        if t == 0 {
+            for b in bins.iter().flatten() {
+                counts[*b] += 1;
+            }
+            pixels = bins.iter().flatten().count();
+        }
+        for (p, &pf) in pixel_filters.iter().enumerate() {
+            let want = reference_image(&store, &Reference::new(pf), &scene, frame, (0.0, 0.0))?;
+            for (f, fname) in FILTERS.iter().enumerate() {
+                let o = SamplerOptions::from_name(fname)?;
+                let got = filter_image(&store, o, &scene, frame, (0.0, 0.0))?;
+                psnr[f][t][p] = scores(&want, &got).psnr_db;
+                if let Some(k) = binned.iter().position(|b| b == fname) {
+                    for (b, cell) in by_bin[2 * t + p][k].iter_mut().enumerate() {
+                        let only = |img: &Image| -> Image {
+                            img.iter()
+                                .zip(&bins)
+                                .map(|(c, &bin)| if bin == Some(b) { *c } else { None })
+                                .collect()
+                        };
+                        *cell = scores(&only(&want), &only(&got)).psnr_db;
+                    }
                 }
             }
         }
     }
     println!(
-        "RMSE against the 64×64 supersampled reference, {} ground-plane pixels (linear RGB):\n",
-        queries.len()
+        "PSNR (dB, linear RGB) against the reference image, {pixels} ground-plane pixels, {frame}:\n"
     );
-    println!("| filter | checker 256² | zone plate 256² |");
-    println!("|---|---:|---:|");
-    for (f, o) in filters.iter().enumerate() {
-        println!("| {} | {:.5} | {:.5} |", o.name(), table[f][0], table[f][1]);
-    }
-    let counts: Vec<usize> = (0..6)
-        .map(|b| bins.iter().filter(|&&x| x == b).count())
-        .collect();
-    println!("\nThe same RMSE by footprint length ρmax (level-0 texels):\n");
     println!(
-        "| texture | filter | ≤ 1 ({}) | 1–2 ({}) | 2–4 ({}) | 4–8 ({}) | 8–16 ({}) | 16–32 ({}) |",
-        counts[0], counts[1], counts[2], counts[3], counts[4], counts[5]
+        "| filter | checker, gaussian | checker, box | zone plate, gaussian | zone plate, box |"
     );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|");
-    for (t, name) in textures.iter().enumerate() {
-        for (k, &f) in binned.iter().enumerate() {
-            let cells: Vec<String> = by_bin[t][k].iter().map(|e| format!("{e:.4}")).collect();
-            println!("| {name} | {} | {} |", filters[f].name(), cells.join(" | "));
+    println!("|---|---:|---:|---:|---:|");
+    for (f, name) in FILTERS.iter().enumerate() {
+        let p = &psnr[f];
+        println!(
+            "| {name} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            p[0][0], p[0][1], p[1][0], p[1][1]
+        );
+    }
+    println!("\nThe same PSNR by footprint length ρmax (level-0 texels; pixels in brackets):\n");
+    let heads: Vec<String> = (0..BINS)
+        .map(|b| {
+            let range = match b {
+                0 => "≤ 1".to_string(),
+                b if b == BINS - 1 => format!("> {}", 1 << (b - 1)),
+                b => format!("{}–{}", 1 << (b - 1), 1 << b),
+            };
+            format!("{range} ({})", counts[b])
+        })
+        .collect();
+    println!("| texture | reference | filter | {} |", heads.join(" | "));
+    println!("|---|---|---|{}", "---:|".repeat(BINS));
+    for (t, tname) in ["checker", "zone plate"].iter().enumerate() {
+        for (p, pf) in pixel_filters.iter().enumerate() {
+            for (k, fname) in binned.iter().enumerate() {
+                let cells: Vec<String> = by_bin[2 * t + p][k]
+                    .iter()
+                    .map(|e| format!("{e:.1}"))
+                    .collect();
+                println!("| {tname} | {pf} | {fname} | {} |", cells.join(" | "));
+            }
         }
     }
     Ok(())

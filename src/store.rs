@@ -63,6 +63,12 @@ impl TextureStore {
         s
     }
 
+    /// The options the chain is built with (its wrap mode is the
+    /// texture's).
+    pub fn options(&self) -> &MipOptions {
+        &self.options
+    }
+
     /// Level 0.
     pub fn base(&self) -> &Texture {
         &self.base

@@ -4,9 +4,9 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use parvo::Texture;
 use parvo::scene::Frame;
 use parvo::texel::{ChannelType, ColorSpace, Format};
-use parvo::Texture;
 
 /// Pixels that show no texture.
 const BACKGROUND: [f32; 3] = [0.02, 0.02, 0.03];

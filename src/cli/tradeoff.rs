@@ -271,7 +271,13 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
             .collect();
         let scale = error_scale(&img0, &ref0);
         write_image(&args.out.join(format!("{name}.png")), frame, &img0)?;
-        write_error_map(&args.out.join(format!("{name}-error.png")), frame, &img0, &ref0, scale)?;
+        write_error_map(
+            &args.out.join(format!("{name}-error.png")),
+            frame,
+            &img0,
+            &ref0,
+            scale,
+        )?;
         if name == "trilinear" || name == "aniso16" {
             let tint = show_levels(&sampler, &q0, &img0);
             write_rgb(&args.out.join(format!("{name}-levels.png")), frame, &tint)?;
@@ -333,11 +339,15 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
     });
     let json_path = args.out.join("report.json");
     parvo::io::atomic::write(&json_path, |w| {
-        w.write_all(serde_json::to_string_pretty(&report).unwrap_or_default().as_bytes())
-            .map_err(|e| parvo::Error::Encode {
-                format: "JSON",
-                reason: e.to_string(),
-            })
+        w.write_all(
+            serde_json::to_string_pretty(&report)
+                .unwrap_or_default()
+                .as_bytes(),
+        )
+        .map_err(|e| parvo::Error::Encode {
+            format: "JSON",
+            reason: e.to_string(),
+        })
     })?;
     let svg = args.out.join("tradeoff.svg");
     plot(&svg, &rows, &args)?;
@@ -401,7 +411,11 @@ fn plot(path: &Path, rows: &[Row], args: &TradeoffArgs) -> Result<()> {
         let (xmin, xmax) = rows.iter().fold((f64::MAX, 0f64), |(a, b), r| {
             (a.min(r.ns_per_pixel), b.max(r.ns_per_pixel))
         });
-        let finite: Vec<f64> = rows.iter().map(|r| r.psnr_db).filter(|p| p.is_finite()).collect();
+        let finite: Vec<f64> = rows
+            .iter()
+            .map(|r| r.psnr_db)
+            .filter(|p| p.is_finite())
+            .collect();
         let (ymin, ymax) = finite
             .iter()
             .fold((f64::MAX, f64::MIN), |(a, b), &p| (a.min(p), b.max(p)));
@@ -470,10 +484,11 @@ fn plot(path: &Path, rows: &[Row], args: &TradeoffArgs) -> Result<()> {
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
     parvo::io::atomic::write(path, |w| {
-        w.write_all(svg.as_bytes()).map_err(|e| parvo::Error::Encode {
-            format: "SVG",
-            reason: e.to_string(),
-        })
+        w.write_all(svg.as_bytes())
+            .map_err(|e| parvo::Error::Encode {
+                format: "SVG",
+                reason: e.to_string(),
+            })
     })?;
     Ok(())
 }

@@ -20,6 +20,10 @@ pub fn rmse(reference: &[[f32; 4]], got: &[[f32; 4]]) -> f64 {
     (sum / (3 * n) as f64).sqrt()
 }
 
+/// The pixels of an image (row-major linear RGBA, `None` where the scene
+/// shows nothing).
+pub type Pixels = [Option<[f32; 4]>];
+
 /// Accuracy of an image against the reference, over the pixels both have,
 /// in linear light over R, G, B (SPEC.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -35,7 +39,7 @@ pub struct Scores {
 }
 
 /// [`Scores`] of `got` against `reference` (row-major, `None` skipped).
-pub fn scores(reference: &[Option<[f32; 4]>], got: &[Option<[f32; 4]>]) -> Scores {
+pub fn scores(reference: &Pixels, got: &Pixels) -> Scores {
     let (mut sum, mut max, mut n) = (0f64, 0f64, 0usize);
     for (r, g) in reference.iter().zip(got) {
         if let (Some(r), Some(g)) = (r, g) {
@@ -57,15 +61,15 @@ pub fn scores(reference: &[Option<[f32; 4]>], got: &[Option<[f32; 4]>]) -> Score
 }
 
 /// RMS over pixels (and R, G, B) of the change between two frames.
-pub fn rms_change(a: &[Option<[f32; 4]>], b: &[Option<[f32; 4]>]) -> f64 {
+pub fn rms_change(a: &Pixels, b: &Pixels) -> f64 {
     scores(a, b).rmse
 }
 
 /// Flicker (SPEC.md): the RMS change of a filter's image between two
 /// frames a quarter pixel apart, minus the reference's own change.
 pub fn flicker(
-    filter: (&[Option<[f32; 4]>], &[Option<[f32; 4]>]),
-    reference: (&[Option<[f32; 4]>], &[Option<[f32; 4]>]),
+    filter: (&Pixels, &Pixels),
+    reference: (&Pixels, &Pixels),
 ) -> f64 {
     rms_change(filter.0, filter.1) - rms_change(reference.0, reference.1)
 }

@@ -6,20 +6,34 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use super::metrics::{Scores, scores};
+use super::reference::Reference;
 use super::{Frame, Scene};
-use crate::sample::{Query, Sampler, TexelSink, mip_linear, mip_nearest};
+use crate::error::Result;
+use crate::sample::{Query, Sampler, SamplerOptions, TexelSink, mip_linear, mip_nearest};
+use crate::store::TextureStore;
 
 /// An image of linear RGBA values, `None` where the scene shows nothing.
 pub type Image = Vec<Option<[f32; 4]>>;
 
 /// Every pixel's query (row-major) with the camera moved by `offset`
 /// pixels, `None` where there is none.
-pub fn queries(scene: &Scene, frame: Frame, tex: (u32, u32), offset: (f64, f64)) -> Vec<Option<Query>> {
+pub fn queries(
+    scene: &Scene,
+    frame: Frame,
+    tex: (u32, u32),
+    offset: (f64, f64),
+) -> Vec<Option<Query>> {
     (0..frame.height)
         .into_par_iter()
         .flat_map_iter(|py| {
             (0..frame.width).map(move |px| {
-                scene.query_at(frame, tex, px as f64 + 0.5 + offset.0, py as f64 + 0.5 + offset.1)
+                scene.query_at(
+                    frame,
+                    tex,
+                    px as f64 + 0.5 + offset.0,
+                    py as f64 + 0.5 + offset.1,
+                )
             })
         })
         .collect()
@@ -33,6 +47,53 @@ pub fn render(sampler: &Sampler, qs: &[Option<Query>]) -> Image {
     let _ = sampler.sample_batch(&dense, &mut out);
     let mut it = out.into_iter();
     qs.iter().map(|q| q.and_then(|_| it.next())).collect()
+}
+
+/// The reference image of `scene` (camera moved by `offset` pixels) for
+/// the texture in `store`, in parallel, without progress reports.
+pub fn reference_image(
+    store: &TextureStore,
+    reference: &Reference,
+    scene: &Scene,
+    frame: Frame,
+    offset: (f64, f64),
+) -> Result<Image> {
+    let level0 = store.reference_sampler(store.options().wrap)?;
+    Ok(reference.render(scene, frame, offset, &level0, &|_| {}))
+}
+
+/// The image the filter `options` renders of `scene` (camera moved by
+/// `offset`) from the texture in `store`, with the store's wrap mode,
+/// building what the filter reads.
+pub fn filter_image(
+    store: &TextureStore,
+    mut options: SamplerOptions,
+    scene: &Scene,
+    frame: Frame,
+    offset: (f64, f64),
+) -> Result<Image> {
+    options.wrap = store.options().wrap;
+    let s = store.sampler(options)?;
+    let b = store.base();
+    Ok(render(
+        &s,
+        &queries(scene, frame, (b.width(), b.height()), offset),
+    ))
+}
+
+/// [`Scores`] of the filter `options` on `scene` against `reference`
+/// (the reference image of the same scene and frame).
+pub fn accuracy(
+    store: &TextureStore,
+    options: SamplerOptions,
+    scene: &Scene,
+    frame: Frame,
+    reference: &Image,
+) -> Result<Scores> {
+    Ok(scores(
+        reference,
+        &filter_image(store, options, scene, frame, (0.0, 0.0))?,
+    ))
 }
 
 /// Median wall time per query of `runs` single-threaded passes of the
