@@ -232,12 +232,16 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
     let layout: Layout = LAYOUT.parse()?;
     let order: RasterOrder = ORDER.parse()?;
 
-    let mut rows = Vec::new();
-    for (name, mut options) in filters {
-        step(&name);
+    let mut samplers = Vec::new();
+    for (_, options) in &mut filters {
         options.wrap = wrap;
-        let sampler = store.sampler(options)?;
-        let ns = ns_per_query(&sampler, &dense, args.runs);
+        samplers.push(store.sampler(*options)?);
+    }
+    step("timing");
+    let timings = ns_per_query(&samplers.iter().collect::<Vec<_>>(), &dense, args.runs);
+    let mut rows = Vec::new();
+    for (((name, options), sampler), ns) in filters.into_iter().zip(samplers).zip(timings) {
+        step(&name);
         let img0 = render(&sampler, &q0);
         let img1 = render(&sampler, &q1);
         let sc = scores(&ref0, &img0);
@@ -439,10 +443,39 @@ fn plot(path: &Path, rows: &[Row], args: &TradeoffArgs) -> Result<()> {
             .map_err(|e| anyhow!("{e}"))?;
         chart
             .configure_mesh()
+            .light_line_style(WHITE)
+            // The x labels are drawn below: 1, 2 and 5 of each decade.
+            .disable_x_mesh()
+            .x_label_formatter(&|_| String::new())
             .x_desc("ns per pixel (one thread)")
             .y_desc("PSNR against the reference (dB)")
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
+        let (x0, x1) = ((xmin * 0.7).max(0.1), xmax * 1.5);
+        let (y0, y1) = ((ymin - 1.0).floor(), (ymax + 1.0).ceil());
+        for d in (x0.log10().floor() as i32)..=(x1.log10().ceil() as i32) {
+            for m in [1.0, 2.0, 5.0] {
+                let v = m * 10f64.powi(d);
+                if v < x0 || v > x1 {
+                    continue;
+                }
+                chart
+                    .draw_series(LineSeries::new([(v, y0), (v, y1)], BLACK.mix(0.12)))
+                    .map_err(|e| anyhow!("{e}"))?;
+                let (px, py) = chart.backend_coord(&(v, y0));
+                let label = if v >= 1.0 {
+                    format!("{v:.0}")
+                } else {
+                    format!("{v}")
+                };
+                root.draw(&Text::new(
+                    label.clone(),
+                    (px - 3 * label.len() as i32, py + 6),
+                    ("sans-serif", 12).into_font(),
+                ))
+                .map_err(|e| anyhow!("{e}"))?;
+            }
+        }
         let mut front: Vec<&Row> = rows
             .iter()
             .filter(|r| {
@@ -461,17 +494,39 @@ fn plot(path: &Path, rows: &[Row], args: &TradeoffArgs) -> Result<()> {
             .map_err(|e| anyhow!("{e}"))?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RED));
-        for r in rows {
+        // Labels placed greedily where they overlap no label placed
+        // before (points close together, such as aniso4..16, would
+        // otherwise print over each other).
+        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+        let mut order: Vec<&Row> = rows.iter().filter(|r| r.psnr_db.is_finite()).collect();
+        order.sort_by(|a, b| a.ns_per_pixel.total_cmp(&b.ns_per_pixel));
+        for r in order {
             let p = (r.ns_per_pixel, r.psnr_db);
+            let (px, py) = chart.backend_coord(&p);
+            let w = 7 * r.name.len() as i32 + 4;
+            let candidates = [(6, 3), (6, -17), (6, 19), (6, -33), (6, 35), (6, -49)];
+            let overlaps = |(x, y): (i32, i32)| {
+                placed.iter().any(|&(a, b, c, d)| {
+                    px + x < c && a < px + x + w && py + y < d && b < py + y + 14
+                })
+            };
+            let (dx, dy) = candidates
+                .iter()
+                .copied()
+                .find(|&o| !overlaps(o))
+                .unwrap_or(candidates[0]);
+            placed.push((px + dx, py + dy, px + dx + w, py + dy + 14));
             chart
-                .draw_series(std::iter::once(Circle::new(p, 4, BLUE.filled())))
-                .map_err(|e| anyhow!("{e}"))?;
-            chart
-                .draw_series(std::iter::once(Text::new(
-                    r.name.clone(),
-                    p,
-                    ("sans-serif", 13).into_font(),
-                )))
+                .draw_series(std::iter::once(
+                    EmptyElement::at(p)
+                        + Circle::new((0, 0), 4, BLUE.filled())
+                        // A leader line where the label had to move away.
+                        + PathElement::new(
+                            if dy == 3 { vec![] } else { vec![(0, 0), (dx, dy + 7)] },
+                            BLACK.mix(0.5),
+                        )
+                        + Text::new(r.name.clone(), (dx + 2, dy), ("sans-serif", 13).into_font()),
+                ))
                 .map_err(|e| anyhow!("{e}"))?;
         }
         chart

@@ -67,9 +67,6 @@ pub fn rms_change(a: &Pixels, b: &Pixels) -> f64 {
 
 /// Flicker (SPEC.md): the RMS change of a filter's image between two
 /// frames a quarter pixel apart, minus the reference's own change.
-pub fn flicker(
-    filter: (&Pixels, &Pixels),
-    reference: (&Pixels, &Pixels),
-) -> f64 {
+pub fn flicker(filter: (&Pixels, &Pixels), reference: (&Pixels, &Pixels)) -> f64 {
     rms_change(filter.0, filter.1) - rms_change(reference.0, reference.1)
 }

@@ -96,21 +96,43 @@ pub fn accuracy(
     ))
 }
 
-/// Median wall time per query of `runs` single-threaded passes of the
-/// untraced fast path over `queries`, in nanoseconds.
-pub fn ns_per_query(sampler: &Sampler, queries: &[Query], runs: usize) -> f64 {
+/// Median wall time per query of each sampler, in nanoseconds: `runs`
+/// rounds, each timing every sampler once in turn (so a drift of the
+/// machine's speed during the measurement reaches all of them alike), of
+/// the untraced fast path over `queries` on the calling thread. Each
+/// timing repeats the whole slice until it lasts at least [`MIN_TIMING`]
+/// (a cheap filter takes about a millisecond per frame, short enough for
+/// one interrupt to move it by tens of per cent); one untimed pass per
+/// sampler first.
+pub fn ns_per_query(samplers: &[&Sampler], queries: &[Query], runs: usize) -> Vec<f64> {
     let mut out = vec![[0f32; 4]; queries.len()];
-    let mut times: Vec<f64> = (0..runs.max(1))
-        .map(|_| {
-            let t = Instant::now();
-            let _ = sampler.sample_slice(queries, &mut out);
-            std::hint::black_box(&out);
-            t.elapsed().as_secs_f64()
-        })
+    let mut pass = |s: &Sampler| {
+        let t = Instant::now();
+        let _ = s.sample_slice(queries, &mut out);
+        std::hint::black_box(&out);
+        t.elapsed().as_secs_f64()
+    };
+    let reps: Vec<usize> = samplers
+        .iter()
+        .map(|s| ((MIN_TIMING / pass(s).max(1e-9)).ceil() as usize).clamp(1, 1000))
         .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2] * 1e9 / queries.len().max(1) as f64
+    let mut times = vec![Vec::new(); samplers.len()];
+    for _ in 0..runs.max(1) {
+        for ((s, &n), t) in samplers.iter().zip(&reps).zip(&mut times) {
+            t.push((0..n).map(|_| pass(s)).sum::<f64>() / n as f64);
+        }
+    }
+    times
+        .into_iter()
+        .map(|mut t| {
+            t.sort_by(f64::total_cmp);
+            t[t.len() / 2] * 1e9 / queries.len().max(1) as f64
+        })
+        .collect()
 }
+
+/// Shortest single timing of [`ns_per_query`], seconds.
+pub const MIN_TIMING: f64 = 0.02;
 
 /// Counts the texels a lookup reads per mip level.
 #[derive(Default)]
