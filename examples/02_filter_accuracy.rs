@@ -21,17 +21,7 @@ use parvo::scene::render::{Image, filter_image, queries, reference_image};
 use parvo::scene::{Frame, Scene};
 use parvo::store::TextureStore;
 
-const FILTERS: [&str; 9] = [
-    "nearest",
-    "bilinear",
-    "trilinear",
-    "aniso2",
-    "aniso4",
-    "aniso8",
-    "aniso16",
-    "ewa",
-    "sat",
-];
+const FILTERS: [&str; 9] = SamplerOptions::REPORT_FILTERS;
 
 fn main() -> Result<(), parvo::Error> {
     let frame = Frame::new(320, 240);
@@ -48,8 +38,7 @@ fn main() -> Result<(), parvo::Error> {
     let mut counts = [0usize; BINS];
     let mut pixels = 0;
     for (t, name) in textures.iter().enumerate() {
-        let loaded = parvo::io::load(name, &parvo::io::Limits::default())?;
-        let store = TextureStore::from_levels(loaded.levels, Default::default());
+        let store = TextureStore::load(name, &parvo::io::Limits::default())?;
         let tex = (store.base().width(), store.base().height());
         let qs = queries(&scene, frame, tex, (0.0, 0.0));
         let tri = SamplerOptions::trilinear();

@@ -63,6 +63,22 @@ impl TextureStore {
         s
     }
 
+    /// A store of the texture `name` (a file or a `builtin:` name, see
+    /// [`crate::io::load`]) under `limits`: the file's own mip levels are
+    /// the chain, and its wrap mode (repeat when it records none) is the
+    /// one mips are built and filters sample with.
+    pub fn load(name: &str, limits: &crate::io::Limits) -> Result<Self> {
+        let loaded = crate::io::load(name, limits)?;
+        let wrap = loaded.info.wrap.unwrap_or_default();
+        Ok(Self::from_levels(
+            loaded.levels,
+            MipOptions {
+                wrap,
+                ..Default::default()
+            },
+        ))
+    }
+
     /// The options the chain is built with (its wrap mode is the
     /// texture's).
     pub fn options(&self) -> &MipOptions {

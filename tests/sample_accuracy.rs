@@ -27,8 +27,7 @@ fn the_winner_depends_on_the_pixel_filter() {
     let frame = Frame::new(320, 240);
     let scene = Scene::default();
     for texture in ["builtin:checker:512", "builtin:zoneplate:512"] {
-        let loaded = parvo::io::load(texture, &parvo::io::Limits::default()).unwrap();
-        let store = TextureStore::from_levels(loaded.levels, Default::default());
+        let store = TextureStore::load(texture, &parvo::io::Limits::default()).unwrap();
         for pf in [PixelFilter::Gaussian, PixelFilter::Box] {
             let want =
                 reference_image(&store, &Reference::new(pf), &scene, frame, (0.0, 0.0)).unwrap();

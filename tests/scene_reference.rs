@@ -12,13 +12,13 @@
 //!   trilinear, and nearest flickers more than trilinear;
 //! - the texture store builds only what the filters read.
 
+use parvo::Wrap;
 use parvo::sample::{Query, SamplerOptions};
 use parvo::scene::metrics::{flicker, scores};
 use parvo::scene::reference::{PixelFilter, Reference};
 use parvo::scene::render::{Image, accuracy, filter_image, reference_image};
 use parvo::scene::{Frame, Scene};
 use parvo::store::TextureStore;
-use parvo::{MipOptions, Wrap};
 
 const SCENES: [&str; 6] = [
     "plane",
@@ -111,14 +111,7 @@ fn rotate_derivatives_are_exact() {
 }
 
 fn default_store() -> TextureStore {
-    let loaded = parvo::io::load("builtin:zoneplate:512", &parvo::io::Limits::default()).unwrap();
-    TextureStore::from_levels(
-        loaded.levels,
-        MipOptions {
-            wrap: Wrap::default(),
-            ..Default::default()
-        },
-    )
+    TextureStore::load("builtin:zoneplate:512", &parvo::io::Limits::default()).unwrap()
 }
 
 fn reference(store: &TextureStore, r: Reference, scene: &Scene, frame: Frame, off: f64) -> Image {

@@ -765,12 +765,5 @@ fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
         }
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
-    parvo::io::atomic::write(path, |w| {
-        w.write_all(svg.as_bytes())
-            .map_err(|e| parvo::Error::Encode {
-                format: "SVG",
-                reason: e.to_string(),
-            })
-    })?;
-    Ok(())
+    super::images::write_text(path, "SVG", &svg)
 }

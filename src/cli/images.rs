@@ -99,3 +99,17 @@ pub fn error_scale(img: &[Option<[f32; 4]>], reference: &[Option<[f32; 4]>]) -> 
     e.sort_by(f64::total_cmp);
     e[(e.len() * 99 / 100).min(e.len() - 1)].max(1e-4)
 }
+
+/// Writes `text` to `path` atomically (a temporary file renamed into
+/// place); `format` names the file type in the error.
+pub fn write_text(path: &Path, format: &'static str, text: &str) -> Result<()> {
+    use std::io::Write;
+    parvo::io::atomic::write(path, |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|e| parvo::Error::Encode {
+                format,
+                reason: e.to_string(),
+            })
+    })
+    .with_context(|| format!("cannot write {}", path.display()))
+}

@@ -52,16 +52,9 @@ pub struct RenderArgs {
 }
 
 pub fn run(args: RenderArgs) -> Result<ExitCode> {
-    let loaded = parvo::io::load(&args.texture, &parvo::io::Limits::default())
+    let store = TextureStore::load(&args.texture, &parvo::io::Limits::default())
         .with_context(|| format!("cannot read texture `{}`", args.texture))?;
-    let wrap = loaded.info.wrap.unwrap_or_default();
-    let store = TextureStore::from_levels(
-        loaded.levels,
-        parvo::MipOptions {
-            wrap,
-            ..Default::default()
-        },
-    );
+    let wrap = store.options().wrap;
     let base = store.base();
     let tex = (base.width(), base.height());
     if args.filter.eq_ignore_ascii_case("reference") {

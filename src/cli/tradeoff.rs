@@ -10,7 +10,7 @@
 //! of trilinear and aniso16). Only what the filters need is built (the
 //! texture store): the report's `built` says what.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -28,7 +28,7 @@ use parvo::scene::render::{ns_per_query, queries, render, show_levels};
 use parvo::scene::{Frame, RasterOrder, Scene};
 use parvo::store::TextureStore;
 
-use super::images::{error_scale, write_error_map, write_image, write_rgb};
+use super::images::{error_scale, write_error_map, write_image, write_rgb, write_text};
 
 /// The cache the traffic figures use (stated in the output).
 const CACHE: &str = "16K:64:4";
@@ -64,7 +64,7 @@ pub struct TradeoffArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "nearest,bilinear,trilinear,aniso2,aniso4,aniso8,aniso16,ewa,sat"
+        default_values_t = SamplerOptions::REPORT_FILTERS.map(String::from)
     )]
     filters: Vec<String>,
     /// Pixel filter of the reference: gaussian or box.
@@ -179,16 +179,9 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
         }
         reference.samples_per_texel = s;
     }
-    let loaded = parvo::io::load(&args.texture, &parvo::io::Limits::default())
+    let store = TextureStore::load(&args.texture, &parvo::io::Limits::default())
         .with_context(|| format!("cannot read texture `{}`", args.texture))?;
-    let wrap = loaded.info.wrap.unwrap_or_default();
-    let store = TextureStore::from_levels(
-        loaded.levels,
-        parvo::MipOptions {
-            wrap,
-            ..Default::default()
-        },
-    );
+    let wrap = store.options().wrap;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let base = store.base();
@@ -342,17 +335,8 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
         })).collect::<Vec<_>>(),
     });
     let json_path = args.out.join("report.json");
-    parvo::io::atomic::write(&json_path, |w| {
-        w.write_all(
-            serde_json::to_string_pretty(&report)
-                .unwrap_or_default()
-                .as_bytes(),
-        )
-        .map_err(|e| parvo::Error::Encode {
-            format: "JSON",
-            reason: e.to_string(),
-        })
-    })?;
+    let text = serde_json::to_string_pretty(&report).context("cannot format report.json")?;
+    write_text(&json_path, "JSON", &text)?;
     let svg = args.out.join("tradeoff.svg");
     plot(&svg, &rows, &args)?;
 
@@ -538,12 +522,5 @@ fn plot(path: &Path, rows: &[Row], args: &TradeoffArgs) -> Result<()> {
             .map_err(|e| anyhow!("{e}"))?;
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
-    parvo::io::atomic::write(path, |w| {
-        w.write_all(svg.as_bytes())
-            .map_err(|e| parvo::Error::Encode {
-                format: "SVG",
-                reason: e.to_string(),
-            })
-    })?;
-    Ok(())
+    super::images::write_text(path, "SVG", &svg)
 }

@@ -30,9 +30,10 @@
 //! texel), texels alternating between two sets of `f32` sums; the bounds
 //! of each run are solved eight runs at a time. On CPUs with AVX2 and FMA
 //! the same code is compiled for them with fused multiply-adds (so the
-//! last bits differ from the portable build). [`ewa_exact`] keeps the
-//! plain form (`exp` per texel, every fetch wrapped, `f64` sums): the
-//! reference the tests hold both paths to (within 1e-3).
+//! last bits differ from the portable build). `ewa_exact` (public as
+//! [`super::Sampler::sample_ewa_exact`]) keeps the plain form (`exp` per
+//! texel, every fetch wrapped, `f64` sums): the reference the tests hold
+//! both paths to (within 1e-3).
 //!
 //! # Bounded work
 //! Rows are scanned only over the span where `r² < 1` (solved per row),

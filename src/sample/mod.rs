@@ -421,6 +421,20 @@ impl SamplerOptions {
         }
     }
 
+    /// The report names of the filters `parvo tradeoff` compares by
+    /// default, cheapest first (SPEC.md report names).
+    pub const REPORT_FILTERS: [&'static str; 9] = [
+        "nearest",
+        "bilinear",
+        "trilinear",
+        "aniso2",
+        "aniso4",
+        "aniso8",
+        "aniso16",
+        "ewa",
+        "sat",
+    ];
+
     /// The preset a report name names: a filter name (`aniso` meaning
     /// aniso16), `aniso2` … `aniso16`, or `bilinear-nomip` (bilinear with
     /// mip mode none: level 0 only).
