@@ -26,6 +26,7 @@ pub mod fast;
 pub mod kernel;
 pub mod nan;
 pub mod normal;
+pub mod roughness;
 pub mod separable;
 mod srgb_simd;
 pub mod weights;
