@@ -72,6 +72,7 @@ pub mod mip;
 pub mod sample;
 pub mod sat;
 pub mod scene;
+pub mod shade;
 pub mod store;
 pub mod texel;
 pub mod texture;

@@ -444,3 +444,72 @@ fn bad_inputs_are_errors() {
         .is_err()
     );
 }
+
+/// The shading check of SPEC.md against the ground truth (every level-0
+/// normal of a footprint shaded and averaged), on Gaussian bumps of two
+/// scales, for both BRDFs (numbers: `examples/04_roughness_mips.rs` and
+/// the README). Asserted as measured:
+/// - from level 2 on the adjusted chain always beats the renormalised one
+///   (RMSE), and at least halves its RMSE once a footprint spans 4σ
+///   (σ = 1.5: from level 3, measured from level 2; σ = 4: from level 4;
+///   Cook-Torrance on σ = 4 at levels 2 and 3 measured 0.63 and 0.56);
+/// - wherever the renormalised chain's peak overshoots the truth's by more
+///   than 25%, the adjusted chain's peak is closer to 1. It does not stay
+///   within 25% at the coarsest levels (0.58–0.78 there: the vMF lobe of
+///   `2/κ ≈ 2(1 − r)` is wider than the bumps' spread of normals), so
+///   that part of the bar is reported, not asserted.
+#[test]
+fn adjusted_roughness_shades_closer_to_the_ground_truth_on_gaussian_bumps() {
+    use parvo::shade::{Brdf, bumps, compare, default_directions};
+    let dirs = default_directions();
+    for (sigma, count, seed) in [(1.5, 2500, 1), (4.0, 400, 2)] {
+        let map = bumps(256, sigma, 1.0, count, seed).unwrap();
+        for brdf in [Brdf::BlinnPhong, Brdf::CookTorrance] {
+            for s in compare(&map, 0.2, brdf, &dirs).unwrap() {
+                let ratio = s.rmse_adjusted / s.rmse_base;
+                println!(
+                    "σ {sigma} {brdf} level {}: RMSE ratio {ratio:.2}, peaks {:.2} → {:.2}",
+                    s.level, s.peak_base, s.peak_adjusted
+                );
+                if s.level >= 2 {
+                    assert!(ratio < 1.0, "σ {sigma} {brdf} level {}: {ratio}", s.level);
+                }
+                if (1u32 << s.level) as f64 >= 4.0 * sigma {
+                    assert!(ratio <= 0.5, "σ {sigma} {brdf} level {}: {ratio}", s.level);
+                }
+                if s.peak_base > 1.25 {
+                    assert!(
+                        (s.peak_adjusted - 1.0).abs() < (s.peak_base - 1.0).abs(),
+                        "σ {sigma} {brdf} level {}: peaks {} {}",
+                        s.level,
+                        s.peak_base,
+                        s.peak_adjusted
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The BRDFs against their formulas at hand-worked directions.
+#[test]
+fn brdfs_follow_the_spec_formulas() {
+    use parvo::shade::{Brdf, dir_at, radiance};
+    use std::f64::consts::PI;
+    let n = [0.0, 0.0, 1.0];
+    // Mirror directions: H = N, N·H = 1.
+    let (l, v) = (dir_at(-30.0), dir_at(30.0));
+    let c = 30f64.to_radians().cos();
+    let bp = radiance(Brdf::BlinnPhong, n, l, v, 48.0);
+    assert!((bp - 50.0 / (2.0 * PI) * c).abs() < 1e-12);
+    // Cook-Torrance at N·H = 1: D = 1/(π m²), G = min(1, 2·N·V/V·H) = 1,
+    // F = Schlick at V·H = cos 30°.
+    let m = 0.2f64;
+    let f = 0.04 + 0.96 * (1.0 - c).powi(5);
+    let want = (1.0 / (PI * m * m)) * f / (PI * c * c) * c;
+    let ct = radiance(Brdf::CookTorrance, n, l, v, m);
+    assert!((ct - want).abs() < 1e-9 * want, "{ct} vs {want}");
+    // Below the horizon: nothing.
+    assert_eq!(radiance(Brdf::CookTorrance, n, dir_at(95.0), v, m), 0.0);
+    assert_eq!(radiance(Brdf::BlinnPhong, n, l, dir_at(-91.0), 48.0), 0.0);
+}

@@ -1,0 +1,326 @@
+//! Shading normal-mapped texels with the lecture's BRDFs, to validate the
+//! roughness chains of [`crate::mip::roughness`] against a ground truth
+//! (SPEC.md "Normal maps and specular roughness").
+//!
+//! - [`Brdf::BlinnPhong`]: `((s + 2)/(2π))·(N·H)^s`.
+//! - [`Brdf::CookTorrance`]: `D·G·F / (π (N·V)(N·L))` with Beckmann
+//!   `D = exp(−tan²θ/m²) / (π m² cos⁴θ)`, the V-groove
+//!   `G = min(1, 2(N·H)(N·V)/(V·H), 2(N·H)(N·L)/(V·H))` and Schlick's `F`
+//!   with `F0 = 0.04`.
+//!
+//! Radiance is the BRDF times `N·L` (0 where the light or the viewer is
+//! below the shading normal). The ground truth of a texel of level k is
+//! the average of the radiance shaded with each unit level-0 normal of its
+//! footprint and the base roughness; [`compare`] sets beside it the
+//! renormalised normal shaded with the base roughness and with the
+//! adjusted one. Blinn-Phong uses the exponent `s = 2/α² − 2` (Walter et
+//! al. 2007) and, adjusted, Toksvig's `s'`.
+//!
+//! [`bumps`], [`v_grooves`] and [`height_field`] make the procedural
+//! normal maps the validation runs on.
+
+use crate::error::{Error, Result};
+use crate::mip::roughness::{self, BaseRoughness, NormalChannels, Specular};
+use crate::mip::{MipFilter, MipOptions};
+use crate::texel::{ChannelType, ColorSpace, Format, Texels};
+use crate::texture::Texture;
+
+use std::f64::consts::PI;
+
+/// A unit vector in the normal map's tangent space (z out of the surface).
+pub type Dir = [f64; 3];
+
+/// The BRDFs of the validation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Brdf {
+    /// Normalised Blinn-Phong.
+    BlinnPhong,
+    /// Cook-Torrance with Beckmann D, V-groove G and Schlick F.
+    CookTorrance,
+}
+
+impl std::fmt::Display for Brdf {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Brdf::BlinnPhong => "blinn-phong",
+            Brdf::CookTorrance => "cook-torrance",
+        })
+    }
+}
+
+fn dot(a: Dir, b: Dir) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(v: Dir) -> Dir {
+    let l = dot(v, v).sqrt();
+    v.map(|c| c / l)
+}
+
+/// The unit direction at `deg` degrees from the normal (+z), in the x-z
+/// plane, towards +x for positive angles.
+pub fn dir_at(deg: f64) -> Dir {
+    let (s, c) = deg.to_radians().sin_cos();
+    [s, 0.0, c]
+}
+
+/// Blinn-Phong exponent of Beckmann roughness `m`: `2/m² − 2`.
+pub fn exponent_of(m: f64) -> f64 {
+    2.0 / (m * m) - 2.0
+}
+
+/// Reflected radiance (BRDF × N·L) of normal `n` lit from `l`, seen from
+/// `v`; `p` is the Beckmann roughness m for Cook-Torrance, the exponent s
+/// for Blinn-Phong.
+pub fn radiance(brdf: Brdf, n: Dir, l: Dir, v: Dir, p: f64) -> f64 {
+    let (nl, nv) = (dot(n, l), dot(n, v));
+    if nl <= 0.0 || nv <= 0.0 {
+        return 0.0;
+    }
+    let h = unit([l[0] + v[0], l[1] + v[1], l[2] + v[2]]);
+    let nh = dot(n, h).max(0.0);
+    match brdf {
+        Brdf::BlinnPhong => (p + 2.0) / (2.0 * PI) * nh.powf(p) * nl,
+        Brdf::CookTorrance => {
+            let m2 = (p * p).max(1e-12);
+            let c2 = nh * nh;
+            if c2 <= 0.0 {
+                return 0.0;
+            }
+            let tan2 = (1.0 - c2) / c2;
+            let d = (-tan2 / m2).exp() / (PI * m2 * c2 * c2);
+            let vh = dot(v, h).max(1e-12);
+            let g = (2.0 * nh * nv / vh).min(2.0 * nh * nl / vh).min(1.0);
+            let f = 0.04 + 0.96 * (1.0 - vh).powi(5);
+            d * g * f / (PI * nv * nl) * nl
+        }
+    }
+}
+
+/// How far one level's approximations are from the ground truth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelScore {
+    /// The level.
+    pub level: usize,
+    /// RMSE over texels and light/view pairs: renormalised normal, base
+    /// roughness.
+    pub rmse_base: f64,
+    /// The same with the adjusted roughness (or Toksvig's exponent).
+    pub rmse_adjusted: f64,
+    /// The brightest value of the level (over texels and pairs), base
+    /// roughness, divided by the ground truth's brightest.
+    pub peak_base: f64,
+    /// The same with the adjusted roughness.
+    pub peak_adjusted: f64,
+    /// The ground truth's brightest value.
+    pub peak_truth: f64,
+}
+
+/// Light/view pairs of the validation: the viewer at 0°, 30°, 60° and 80°
+/// from the normal (80° grazing), each with the light at the mirror
+/// direction (the highlight) and 20° off it.
+pub fn default_directions() -> Vec<(Dir, Dir)> {
+    let mut d = Vec::new();
+    for view in [0.0, 30.0, 60.0, 80.0] {
+        for off in [0.0, 20.0] {
+            let light: f64 = -view + off;
+            d.push((dir_at(light.clamp(-89.0, 89.0)), dir_at(view)));
+        }
+    }
+    d
+}
+
+/// Per level from 1 on, the renormalised and the adjusted chains of
+/// `normals` (a square power-of-two map, box mips) shaded with `brdf` at
+/// base roughness `alpha` against the ground truth, over `dirs`.
+pub fn compare(
+    normals: &Texture,
+    alpha: f32,
+    brdf: Brdf,
+    dirs: &[(Dir, Dir)],
+) -> Result<Vec<LevelScore>> {
+    let (w, h) = (normals.width() as usize, normals.height() as usize);
+    if !w.is_power_of_two() || !h.is_power_of_two() {
+        return Err(Error::InvalidOption(format!(
+            "the shading comparison needs a power-of-two map (footprints are blocks), not {w}x{h}"
+        )));
+    }
+    if !(alpha > 0.0 && alpha <= 1.0) {
+        return Err(Error::InvalidOption(format!(
+            "the base roughness must be above 0 and at most 1, not {alpha}"
+        )));
+    }
+    let o = MipOptions::with_filter(MipFilter::Box);
+    let spec = match brdf {
+        Brdf::CookTorrance => Specular::Roughness,
+        Brdf::BlinnPhong => Specular::BlinnPhong(exponent_of(alpha as f64) as f32),
+    };
+    let chain = roughness::build(
+        normals,
+        NormalChannels::Xyz,
+        BaseRoughness::Constant(alpha),
+        spec,
+        &o,
+        &mut |_| {},
+    )?;
+    let base_p = match brdf {
+        Brdf::CookTorrance => alpha as f64,
+        Brdf::BlinnPhong => exponent_of(alpha as f64),
+    };
+    let n0: Vec<Dir> = f32s(&chain.normals[0])?
+        .chunks_exact(3)
+        .map(|n| [n[0] as f64, n[1] as f64, n[2] as f64])
+        .collect();
+    let mut out = Vec::new();
+    for k in 1..chain.normals.len() {
+        let lw = (w >> k).max(1);
+        let lh = (h >> k).max(1);
+        let (bw, bh) = (w / lw, h / lh);
+        let nk = f32s(&chain.normals[k])?;
+        let pk = f32s(&chain.specular[k])?;
+        let (mut se_b, mut se_a, mut n) = (0f64, 0f64, 0usize);
+        let (mut peak_t, mut peak_b, mut peak_a) = (0f64, 0f64, 0f64);
+        for ty in 0..lh {
+            for tx in 0..lw {
+                let i = ty * lw + tx;
+                let nbar = [nk[3 * i] as f64, nk[3 * i + 1] as f64, nk[3 * i + 2] as f64];
+                let p_adj = pk[i] as f64;
+                for &(l, v) in dirs {
+                    let mut truth = 0.0;
+                    for y in ty * bh..(ty + 1) * bh {
+                        for x in tx * bw..(tx + 1) * bw {
+                            truth += radiance(brdf, n0[y * w + x], l, v, base_p);
+                        }
+                    }
+                    truth /= (bw * bh) as f64;
+                    let b = radiance(brdf, nbar, l, v, base_p);
+                    let a = radiance(brdf, nbar, l, v, p_adj);
+                    se_b += (b - truth).powi(2);
+                    se_a += (a - truth).powi(2);
+                    n += 1;
+                    peak_t = peak_t.max(truth);
+                    peak_b = peak_b.max(b);
+                    peak_a = peak_a.max(a);
+                }
+            }
+        }
+        let peak_t = peak_t.max(1e-300);
+        out.push(LevelScore {
+            level: k,
+            rmse_base: (se_b / n as f64).sqrt(),
+            rmse_adjusted: (se_a / n as f64).sqrt(),
+            peak_base: peak_b / peak_t,
+            peak_adjusted: peak_a / peak_t,
+            peak_truth: peak_t,
+        });
+    }
+    Ok(out)
+}
+
+fn f32s(t: &Texture) -> Result<&[f32]> {
+    match t.texels() {
+        Texels::F32(v) => Ok(v),
+        _ => Err(Error::InvalidOption("expected f32 texels".into())),
+    }
+}
+
+/// The float normal map of a height field `height(x, y)` (texel units;
+/// central differences, wrapping), `size`².
+pub fn normals_of_height(size: u32, height: impl Fn(f64, f64) -> f64) -> Result<Texture> {
+    let s = size as f64;
+    let mut v = Vec::with_capacity((size * size * 3) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let (x, y) = (x as f64, y as f64);
+            let hx = (height((x + 1.0) % s, y) - height((x - 1.0 + s) % s, y)) * 0.5;
+            let hy = (height(x, (y + 1.0) % s) - height(x, (y - 1.0 + s) % s)) * 0.5;
+            let n = unit([-hx, -hy, 1.0]);
+            v.extend(n.map(|c| c as f32));
+        }
+    }
+    Texture::from_f32(
+        size,
+        size,
+        Format::new(3, ChannelType::F32, ColorSpace::Linear),
+        v,
+    )
+}
+
+/// A deterministic generator for the procedural maps (SplitMix64).
+struct Mix(u64);
+
+impl Mix {
+    fn unit(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Gaussian bumps of standard deviation `sigma` texels and height
+/// `height`·sigma at random places (`count` of them, wrapping), `size`².
+pub fn bumps(size: u32, sigma: f64, height: f64, count: usize, seed: u64) -> Result<Texture> {
+    let mut r = Mix(seed);
+    let s = size as f64;
+    let centres: Vec<(f64, f64, f64)> = (0..count)
+        .map(|_| {
+            (
+                r.unit() * s,
+                r.unit() * s,
+                if r.unit() < 0.5 { -1.0 } else { 1.0 },
+            )
+        })
+        .collect();
+    normals_of_height(size, |x, y| {
+        let mut z = 0.0;
+        for &(cx, cy, sign) in &centres {
+            let dx = (x - cx + s * 1.5).rem_euclid(s) - s * 0.5;
+            let dy = (y - cy + s * 1.5).rem_euclid(s) - s * 0.5;
+            let d2 = dx * dx + dy * dy;
+            if d2 < 16.0 * sigma * sigma {
+                z += sign * height * sigma * (-d2 / (2.0 * sigma * sigma)).exp();
+            }
+        }
+        z
+    })
+}
+
+/// Parallel V-grooves along y, `period` texels apart, walls at
+/// `slope_deg` degrees.
+pub fn v_grooves(size: u32, period: f64, slope_deg: f64) -> Result<Texture> {
+    let t = slope_deg.to_radians().tan();
+    normals_of_height(size, |x, _| {
+        let p = (x / period).fract();
+        (0.5 - (p - 0.5).abs()) * period * t
+    })
+}
+
+/// A rough, natural-looking height field: octaves of smooth value noise
+/// (periods from `size`/4 down to 2 texels, amplitude ∝ period).
+pub fn height_field(size: u32, roughness: f64, seed: u64) -> Result<Texture> {
+    let mut r = Mix(seed);
+    let mut octaves = Vec::new();
+    let mut period = (size / 4).max(2) as usize;
+    while period >= 2 {
+        let n = (size as usize).div_ceil(period);
+        let grid: Vec<f64> = (0..n * n).map(|_| r.unit() - 0.5).collect();
+        octaves.push((period, n, grid));
+        period /= 2;
+    }
+    normals_of_height(size, |x, y| {
+        let mut z = 0.0;
+        for (p, n, g) in &octaves {
+            let (fx, fy) = (x / *p as f64, y / *p as f64);
+            let (ix, iy) = (fx.floor() as usize, fy.floor() as usize);
+            let (tx, ty) = (fx - ix as f64, fy - iy as f64);
+            let (sx, sy) = (tx * tx * (3.0 - 2.0 * tx), ty * ty * (3.0 - 2.0 * ty));
+            let at = |i: usize, j: usize| g[(j % n) * n + (i % n)];
+            let a = at(ix, iy) + (at(ix + 1, iy) - at(ix, iy)) * sx;
+            let b = at(ix, iy + 1) + (at(ix + 1, iy + 1) - at(ix, iy + 1)) * sx;
+            z += (a + (b - a) * sy) * *p as f64 * roughness;
+        }
+        z
+    })
+}
