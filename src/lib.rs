@@ -69,6 +69,7 @@ pub mod error;
 pub mod io;
 mod mem;
 pub mod mip;
+pub mod pipeline;
 pub mod sample;
 pub mod sat;
 pub mod scene;

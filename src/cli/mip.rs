@@ -1,36 +1,30 @@
 //! `parvo mip`: build renderer-ready mip-mapped textures (EXR, KTX2, DDS,
 //! one PNG per level) from images, as maketx, nvtt_export and toktx do.
 //!
-//! Per input: load (with decoder limits) → resolve the output format →
-//! fingerprint (for `--update`) → build the chain with
-//! [`parvo::mip::build_with_progress`] → convert each level to the output
-//! type → write atomically. Inputs of a batch run in parallel (rayon); a
-//! failing input prints one line `parvo: INPUT: reason` and sets exit code
-//! 1, the others are still written.
-//!
-//! Type conversion: when the output type differs from the source (the
-//! common 8-bit sRGB PNG → half EXR), level 0 is decoded once to linear f32,
-//! the chain is built in f32 and each level is quantised once at the end.
-//! Building in the source type would round every intermediate level to 8
-//! bits; decoding first costs memory (4 bytes per channel) but is the most
-//! accurate, and the f32 box path is the fastest one.
+//! The arguments become a job list and [`parvo::pipeline::Settings`]; the
+//! library's [`parvo::pipeline`] plans, builds and writes (the same batch
+//! and `--update` behaviour for programs that embed parvo). This layer
+//! parses, draws the progress bar and prints one line per input; a failing
+//! input prints `parvo: INPUT: reason` and sets exit code 1, the others
+//! are still written.
 
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Mutex;
 use std::time::Instant;
 
-use anyhow::{Context, anyhow};
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
-use rayon::prelude::*;
 
+use parvo::Wrap;
 use parvo::io::exr::ExrCompression;
-use parvo::io::{self, FileFormat, Limits, OutputKind, SaveOptions};
-use parvo::mip::{self, MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
-use parvo::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
-use parvo::{Texture, Wrap};
+use parvo::io::{self, Limits, OutputKind};
+use parvo::mip::{MipFilter, NanPolicy, Rounding};
+use parvo::pipeline::{
+    self, AlphaChoice, ColorChoice, Extension, Job, Outcome, Settings, Stage, Status,
+};
+use parvo::texel::ChannelType;
 
 /// How to interpret the colour channels of the input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -279,44 +273,66 @@ pub(crate) fn parse_bytes(s: &str) -> Result<u64, String> {
         .ok_or_else(|| format!("`{s}` is not a byte count such as 4G or 512M"))
 }
 
-/// What happened to one input.
-#[derive(Debug)]
-enum Status {
-    Written,
-    UpToDate,
-    DryRun,
-}
-
-impl Status {
-    fn name(&self) -> &'static str {
-        match self {
-            Status::Written => "written",
-            Status::UpToDate => "up to date",
-            Status::DryRun => "dry run",
+impl From<ColorArg> for ColorChoice {
+    fn from(c: ColorArg) -> Self {
+        match c {
+            ColorArg::Auto => ColorChoice::Auto,
+            ColorArg::Linear => ColorChoice::Linear,
+            ColorArg::Srgb => ColorChoice::Srgb,
         }
     }
 }
 
-#[derive(Debug)]
-struct Outcome {
-    output: PathBuf,
-    status: Status,
-    width: u32,
-    height: u32,
-    format: Format,
-    level_sizes: Vec<(u32, u32)>,
-    read_s: f64,
-    build_s: f64,
-    write_s: f64,
-    /// What the loader did that the user would not assume, for stderr.
-    notes: Vec<String>,
+impl From<AlphaArg> for AlphaChoice {
+    fn from(a: AlphaArg) -> Self {
+        match a {
+            AlphaArg::Auto => AlphaChoice::Auto,
+            AlphaArg::Straight => AlphaChoice::Straight,
+            AlphaArg::Premultiplied => AlphaChoice::Premultiplied,
+            AlphaArg::None => AlphaChoice::None,
+        }
+    }
 }
 
-/// One job: an input and where it goes.
-struct Job {
-    input: String,
-    output: PathBuf,
-    kind: OutputKind,
+impl From<ExtArg> for Extension {
+    fn from(e: ExtArg) -> Self {
+        match e {
+            ExtArg::Exr => Extension::Exr,
+            ExtArg::Ktx2 => Extension::Ktx2,
+            ExtArg::Dds => Extension::Dds,
+            ExtArg::Png => Extension::Png,
+        }
+    }
+}
+
+/// The library settings of these arguments.
+fn settings(args: &MipArgs) -> Settings {
+    Settings {
+        filter: args.filter,
+        wrap: args.wrap,
+        rounding: args.rounding,
+        levels: args.levels,
+        alpha_coverage: args.alpha_coverage,
+        normal_map: args.normal_map,
+        nan_policy: args.fixnan,
+        color: args.color.into(),
+        alpha: args.alpha.into(),
+        out_type: args.out_type,
+        tile: args.tile,
+        compression: args.compression,
+        load: io::LoadOptions {
+            channels: args.channels.clone(),
+            subimage: args.subimage,
+            auto_orient: !args.no_auto_orient,
+        },
+        limits: Limits {
+            max_width: args.max_width,
+            max_height: args.max_height,
+            max_alloc: args.max_alloc,
+        },
+        update: args.update,
+        dry_run: args.dry_run,
+    }
 }
 
 pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
@@ -333,14 +349,6 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
             .num_threads(n)
             .build_global();
     }
-    if args.levels == Some(0) {
-        return usage("--levels must be at least 1".into());
-    }
-    if let Some(r) = args.alpha_coverage
-        && !(r > 0.0 && r < 1.0)
-    {
-        return usage(format!("--alpha-coverage {r}: must be between 0 and 1"));
-    }
     let jobs = match (&args.output, &args.out_dir) {
         (Some(out), None) => {
             if args.inputs.len() != 1 {
@@ -349,56 +357,18 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
                     args.inputs.len()
                 ));
             }
-            let kind = match OutputKind::from_path(out) {
-                Ok(k) => k,
+            match Job::new(&args.inputs[0], out) {
+                Ok(j) => vec![j],
                 Err(e) => return usage(e.to_string()),
-            };
-            vec![Job {
-                input: args.inputs[0].clone(),
-                output: out.clone(),
-                kind,
-            }]
-        }
-        (None, Some(dir)) => {
-            let mut jobs: Vec<Job> = Vec::new();
-            for input in &args.inputs {
-                let (output, kind) = batch_output(dir, input, args.ext);
-                jobs.push(Job {
-                    input: input.clone(),
-                    output,
-                    kind,
-                });
             }
-            jobs
         }
+        (None, Some(dir)) => Job::batch(&args.inputs, dir, args.ext.into()),
         _ => return usage("give -o OUTPUT (one input) or --out-dir DIR (a batch)".into()),
     };
-    // A channel type the container cannot store is a usage error, found
-    // before any input is read.
-    if let Some(t) = args.out_type
-        && let Some(j) = jobs.iter().find(|j| !j.kind.supports(t))
-    {
-        return usage(format!(
-            "--type {t}: {} cannot store {t} texels (EXR: f16, f32; PNG: u8, u16; KTX2 and DDS: all)",
-            j.kind.name()
-        ));
-    }
-    // Containers whose level sizes are fixed by their specification.
-    if args.rounding == Rounding::Up
-        && let Some(j) = jobs
-            .iter()
-            .find(|j| matches!(j.kind, OutputKind::Ktx2 | OutputKind::Dds))
-    {
-        return usage(format!(
-            "--rounding up: {} defines its level sizes as floor(size / 2^k); \
-             use .exr or PNG levels for rounded-up chains (output {})",
-            if j.kind == OutputKind::Ktx2 {
-                "KTX2"
-            } else {
-                "DDS"
-            },
-            j.output.display()
-        ));
+    let settings = settings(&args);
+    // Usage errors, found before any input is read.
+    if let Err(e) = pipeline::check(&jobs, &settings) {
+        return usage(e.to_string());
     }
     // Report panics (bugs in parvo or a dependency) as per-file errors, not
     // as the default multi-line message.
@@ -410,71 +380,61 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
         eprintln!("parvo: interrupted; no output was left half-written");
         std::process::exit(130);
     });
-    let limits = Limits {
-        max_width: args.max_width,
-        max_height: args.max_height,
-        max_alloc: args.max_alloc,
-    };
     let tty = std::io::stderr().is_terminal() && !args.json;
     let batch = jobs.len() > 1;
-    let bar = if tty {
-        let b = if batch {
-            ProgressBar::new(jobs.len() as u64).with_style(
-                ProgressStyle::with_template("{bar:40} {pos}/{len} files {elapsed_precise} {msg}")
-                    .expect("valid template"),
-            )
+    let bar = tty.then(|| {
+        let template = if batch {
+            "{bar:40} {pos}/{len} files {elapsed_precise} {msg}"
         } else {
-            ProgressBar::new(0).with_style(
-                ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} {msg}")
-                    .expect("valid template"),
-            )
+            "{bar:40} {percent:>3}% {elapsed_precise} {msg}"
         };
-        Some(b)
-    } else {
-        None
-    };
-    // Two inputs with the same output name would overwrite each other.
-    let mut seen = std::collections::HashMap::new();
-    let dup: Vec<Option<String>> = jobs
-        .iter()
-        .map(|j| seen.insert(j.output.clone(), j.input.clone()))
-        .collect();
+        ProgressBar::new(if batch { jobs.len() as u64 } else { 0 })
+            .with_style(ProgressStyle::with_template(template).expect("valid template"))
+    });
     let failed = Mutex::new(0usize);
     let print = Mutex::new(());
-    let work = |(job, dup): (&Job, &Option<String>)| {
-        let t0 = Instant::now();
-        let result = match dup {
-            Some(first) => Err(anyhow!(
-                "output {} is also the output of {first}",
-                job.output.display()
-            )),
-            None => std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                process(job, &args, &limits, if batch { None } else { bar.as_ref() })
-            }))
-            .unwrap_or_else(|p| {
-                Err(anyhow!(
-                    "internal error: {}",
-                    io::atomic::panic_message(&*p)
-                ))
-            }),
+    let started = Instant::now();
+    let single = jobs.first().map(|j| (j.input.clone(), j.output.clone()));
+    let mut progress = |stage: Stage| {
+        let (Some(b), Some((input, output))) = (&bar, &single) else {
+            return;
         };
+        match stage {
+            Stage::Building { total_texels } => {
+                b.set_length(total_texels.max(1));
+                b.set_message(input.clone());
+            }
+            Stage::Built { texels_done } => b.set_position(texels_done),
+            Stage::Writing => b.set_message(format!("{input}: writing {}", output.display())),
+        }
+    };
+    let done = |job: &Job, result: parvo::Result<Outcome>| {
+        // A single job's time is the run's; a batch's jobs overlap, so
+        // each reports the sum of its own phases.
+        let secs = started.elapsed().as_secs_f64();
         let _guard = print.lock().unwrap_or_else(|e| e.into_inner());
         let line = |s: String| match &bar {
             Some(b) => b.suspend(|| println!("{s}")),
             None => println!("{s}"),
         };
+        let warn = |s: String| match &bar {
+            Some(b) => b.suspend(|| eprintln!("{s}")),
+            None => eprintln!("{s}"),
+        };
         match result {
             Ok(o) => {
+                let secs = if batch {
+                    o.read_s + o.build_s + o.write_s
+                } else {
+                    secs
+                };
                 for n in &o.notes {
-                    match &bar {
-                        Some(b) => b.suspend(|| eprintln!("parvo: {}: {n}", job.input)),
-                        None => eprintln!("parvo: {}: {n}", job.input),
-                    }
+                    warn(format!("parvo: {}: {n}", job.input));
                 }
                 if args.json {
-                    line(json_line(job, &o, t0.elapsed().as_secs_f64()));
+                    line(json_line(job, &o, secs));
                 } else {
-                    line(summary_line(job, &o, &args, t0.elapsed().as_secs_f64()));
+                    line(summary_line(job, &o, &args, secs));
                     if args.stats {
                         line(stats_line(&o));
                     }
@@ -482,11 +442,8 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
             }
             Err(e) => {
                 *failed.lock().unwrap_or_else(|e| e.into_inner()) += 1;
-                let msg = format!("{e:#}").replace('\n', " ");
-                match &bar {
-                    Some(b) => b.suspend(|| eprintln!("parvo: {}: {msg}", job.input)),
-                    None => eprintln!("parvo: {}: {msg}", job.input),
-                }
+                let msg = e.to_string().replace('\n', " ");
+                warn(format!("parvo: {}: {msg}", job.input));
                 if args.json {
                     line(
                         serde_json::json!({
@@ -504,11 +461,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
             b.inc(1);
         }
     };
-    if batch {
-        jobs.par_iter().zip(dup.par_iter()).for_each(work);
-    } else {
-        jobs.iter().zip(dup.iter()).for_each(work);
-    }
+    pipeline::run(&jobs, &settings, &mut progress, &done);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -518,433 +471,6 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
-}
-
-fn batch_output(dir: &Path, input: &str, ext: ExtArg) -> (PathBuf, OutputKind) {
-    let stem = if parvo::builtin::is_builtin(input) {
-        input.replace(':', "-")
-    } else {
-        Path::new(input)
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "output".into())
-    };
-    match ext {
-        ExtArg::Exr => (dir.join(format!("{stem}.exr")), OutputKind::Exr),
-        ExtArg::Ktx2 => (dir.join(format!("{stem}.ktx2")), OutputKind::Ktx2),
-        ExtArg::Dds => (dir.join(format!("{stem}.dds")), OutputKind::Dds),
-        ExtArg::Png => (
-            dir.join(format!("{stem}_{{level}}.png")),
-            OutputKind::PngLevels,
-        ),
-    }
-}
-
-/// The output texel format for a source format, container and options.
-fn output_format(src: Format, kind: OutputKind, args: &MipArgs) -> anyhow::Result<Format> {
-    let ty = match args.out_type {
-        Some(t) => t,
-        None => match kind {
-            OutputKind::Exr if src.channel_type == ChannelType::F32 => ChannelType::F32,
-            OutputKind::Exr => ChannelType::F16,
-            OutputKind::PngLevels if src.channel_type == ChannelType::U8 => ChannelType::U8,
-            OutputKind::PngLevels => ChannelType::U16,
-            OutputKind::Ktx2 | OutputKind::Dds => src.channel_type,
-        },
-    };
-    if !kind.supports(ty) {
-        anyhow::bail!(
-            "{} cannot store {ty} texels (EXR: f16, f32; PNG: u8, u16)",
-            kind.name()
-        );
-    }
-    // Floats are linear light; integer outputs keep the source's encoding
-    // (a float source gives linear integers).
-    let cs = if ty.is_float() || src.channel_type.is_float() {
-        ColorSpace::Linear
-    } else {
-        src.color_space
-    };
-    // Each container's alpha convention: OpenEXR defines colour as
-    // associated with alpha, PNG as unassociated; KTX2 and DDS say which in
-    // their headers, so they keep the source's.
-    let alpha = match kind {
-        OutputKind::Exr if src.has_alpha() => AlphaMode::Premultiplied,
-        OutputKind::PngLevels if src.has_alpha() => AlphaMode::Straight,
-        _ => src.alpha,
-    };
-    let f = Format::new(src.channels, ty, cs).with_alpha(alpha);
-    Ok(match kind {
-        OutputKind::Ktx2 => io::ktx2::storable(f),
-        OutputKind::Dds => io::dds::storable(f),
-        _ => f,
-    })
-}
-
-fn options_string(args: &MipArgs, opts: &MipOptions, out: &Format, kind: OutputKind) -> String {
-    format!(
-        "parvo {} filter={} wrap={},{} rounding={} levels={} coverage={:?} normal={} fixnan={} out={out} kind={kind:?} tile={}x{} compression={}",
-        env!("CARGO_PKG_VERSION"),
-        opts.filter,
-        opts.wrap.u,
-        opts.wrap.v,
-        opts.rounding,
-        opts.max_levels
-            .map_or("full".to_string(), |n| n.to_string()),
-        opts.alpha_coverage,
-        opts.normal_map,
-        opts.nan_policy,
-        args.tile.0,
-        args.tile.1,
-        args.compression,
-    )
-}
-
-fn process(
-    job: &Job,
-    args: &MipArgs,
-    limits: &Limits,
-    bar: Option<&ProgressBar>,
-) -> anyhow::Result<Outcome> {
-    let t_read = Instant::now();
-    let load_options = io::LoadOptions {
-        channels: args.channels.clone(),
-        subimage: args.subimage,
-        auto_orient: !args.no_auto_orient,
-    };
-    let loaded = io::load_with(&job.input, limits, &load_options)?;
-    let src_kind = loaded.info.format;
-    let file_wrap = loaded.info.wrap;
-    let mut notes = loaded.info.notes.clone();
-    let channel_names = loaded.info.channel_names.clone();
-    let mut base = loaded.into_base();
-    // Interpretation of the input.
-    let mut src = base.format();
-    src.color_space = match (args.color, args.normal_map) {
-        (ColorArg::Linear, _) | (ColorArg::Auto, true) => ColorSpace::Linear,
-        (ColorArg::Srgb, _) => ColorSpace::Srgb,
-        // The loader's reading of the file (see io::load).
-        (ColorArg::Auto, false) => src.color_space,
-    };
-    src.alpha = match args.alpha {
-        // A normal map's fourth channel is data, not alpha.
-        _ if args.normal_map => AlphaMode::None,
-        AlphaArg::Auto => src.alpha,
-        AlphaArg::Straight => AlphaMode::Straight,
-        AlphaArg::Premultiplied => AlphaMode::Premultiplied,
-        AlphaArg::None => AlphaMode::None,
-    };
-    base = base.reinterpret(src)?;
-    let read_s = t_read.elapsed().as_secs_f64();
-
-    let out_format = output_format(src, job.kind, args)?;
-    let options = MipOptions {
-        filter: args.filter,
-        wrap: args.wrap.or(file_wrap).unwrap_or_default(),
-        rounding: args.rounding,
-        max_levels: args.levels,
-        alpha_coverage: args.alpha_coverage,
-        alpha_store: Some(out_format.channel_type),
-        normal_map: args.normal_map,
-        nan_policy: args.fixnan,
-        fast_paths: true,
-    };
-    if job.kind == OutputKind::Exr {
-        let full = mip::level_count(base.width(), base.height(), args.rounding, None);
-        if args.levels.is_some_and(|n| n < full) {
-            anyhow::bail!(
-                "a mip-mapped OpenEXR file holds the full chain ({full} levels); --levels applies to .ktx2, .dds and PNG"
-            );
-        }
-    }
-    let level_sizes = mip::level_sizes(base.width(), base.height(), args.rounding, args.levels);
-    let (width, height) = (base.width(), base.height());
-    let fingerprint = io::fingerprint(
-        &base,
-        &options_string(args, &options, &out_format, job.kind),
-    );
-    if args.dry_run {
-        return Ok(Outcome {
-            output: job.output.clone(),
-            status: Status::DryRun,
-            width,
-            height,
-            format: out_format,
-            level_sizes,
-            read_s,
-            build_s: 0.0,
-            write_s: 0.0,
-            notes: notes.clone(),
-        });
-    }
-    if args.update
-        && io::stored_fingerprint(&job.output, job.kind).as_deref() == Some(fingerprint.as_str())
-    {
-        return Ok(Outcome {
-            output: job.output.clone(),
-            status: Status::UpToDate,
-            width,
-            height,
-            format: out_format,
-            level_sizes,
-            read_s,
-            build_s: 0.0,
-            write_s: 0.0,
-            notes: notes.clone(),
-        });
-    }
-
-    let t_build = Instant::now();
-    if let Some(b) = bar {
-        let total: u64 = level_sizes[1..]
-            .iter()
-            .map(|&(w, h)| w as u64 * h as u64)
-            .sum();
-        b.set_length(total.max(1));
-        b.set_message(job.input.clone());
-    }
-    let mut on_progress = |p: mip::Progress| {
-        if let Some(b) = bar {
-            b.set_position(p.texels_done);
-        }
-    };
-    let association =
-        (out_format.has_alpha() && src.alpha != out_format.alpha).then_some(out_format.alpha);
-    // Alpha coverage is matched on the unrounded filtered alpha (rounding
-    // each level to 8 bits first would tie texels the test must separate),
-    // so it always builds in f32.
-    let same = src.channel_type == out_format.channel_type
-        && src.color_space == out_format.color_space
-        && association.is_none()
-        && args.alpha_coverage.is_none();
-    let levels = if args.normal_map {
-        // Decoded to vectors, averaged in f32, encoded once per level into
-        // the output type (parvo::mip::normal).
-        mip::normal::build(base, &options, out_format, &mut on_progress)?
-    } else {
-        let (levels, clip_note) = build_colour(
-            base,
-            &options,
-            src,
-            out_format,
-            association,
-            same,
-            &mut on_progress,
-        )?;
-        notes.extend(clip_note);
-        levels
-    };
-    let build_s = t_build.elapsed().as_secs_f64();
-    if let Some(b) = bar {
-        b.set_message(format!("{}: writing {}", job.input, job.output.display()));
-    }
-
-    let t_write = Instant::now();
-    let save = SaveOptions {
-        // An EXR source's channel names carry to EXR output (N.X stays
-        // N.X, a lone Z stays Z); other sources get the layout's names.
-        channel_names: (src_kind == FileFormat::Exr
-            && channel_names.len() == out_format.channels as usize)
-            .then_some(channel_names),
-        wrap: options.wrap,
-        tile: args.tile,
-        compression: args.compression,
-        fingerprint: Some(fingerprint),
-        attributes: vec![
-            ("parvo:filter".into(), args.filter.to_string()),
-            ("parvo:source".into(), src.to_string()),
-            ("parvo:rounding".into(), args.rounding.to_string()),
-        ],
-    };
-    io::save(&levels, args.rounding, &job.output, job.kind, &save)
-        .with_context(|| format!("writing {}", job.output.display()))?;
-    if job.kind == OutputKind::PngLevels {
-        // Levels an earlier, longer chain left behind under this template.
-        let stale = io::png_levels::remove_stale(&job.output, levels.len())?;
-        let list = |v: &[PathBuf]| {
-            v.iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        if !stale.removed.is_empty() {
-            notes.push(format!(
-                "removed {} stale level file(s) of an earlier run: {}",
-                stale.removed.len(),
-                list(&stale.removed)
-            ));
-        }
-        if !stale.foreign.is_empty() {
-            notes.push(format!(
-                "left alone (not written by parvo): {}",
-                list(&stale.foreign)
-            ));
-        }
-    }
-    let write_s = t_write.elapsed().as_secs_f64();
-    Ok(Outcome {
-        output: job.output.clone(),
-        status: Status::Written,
-        width,
-        height,
-        format: out_format,
-        level_sizes,
-        read_s,
-        build_s,
-        write_s,
-        notes,
-    })
-}
-
-/// The colour chain: built in the source format when it is the output
-/// format, else in linear f32 from a single decode of level 0 (see the
-/// module docs), each level converted to the output format.
-fn build_colour(
-    base: Texture,
-    options: &MipOptions,
-    src: Format,
-    out_format: Format,
-    association: Option<AlphaMode>,
-    same: bool,
-    progress: &mut dyn FnMut(mip::Progress),
-) -> anyhow::Result<(Vec<Texture>, Option<String>)> {
-    let work_base = if same {
-        base
-    } else {
-        // Decode straight into the f32 buffer (`Texture::convert` would
-        // hold a second full-size f32 copy while encoding).
-        let f =
-            Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
-        let mut linear = vec![0f32; base.texels().len()];
-        parvo::texel::decode_to_linear(&base.format(), base.texels(), &mut linear);
-        let (w, h) = (base.width(), base.height());
-        drop(base);
-        Texture::from_f32(w, h, f, linear)?
-    };
-    let chain: MipChain = mip::build_with_progress(work_base, options, progress)?;
-    // Float data (HDR) written to a normalised type is clipped to [0, 1]:
-    // count the texels that lose something, to say so once.
-    let count_clipped = src.channel_type.is_float() && !out_format.channel_type.is_float();
-    let mut clipped = 0u64;
-    let mut texels = 0u64;
-    // Smallest level first, so level 0's f32 and converted copies never
-    // coexist with the unconverted rest of the chain.
-    let mut levels: Vec<Texture> = Vec::with_capacity(chain.len());
-    for l in chain.into_levels().into_iter().rev() {
-        let l = associate(l, association)?;
-        if count_clipped {
-            clipped += outside_unit_range(&l);
-            texels += l.texel_count() as u64;
-        }
-        levels.push(convert_level(l, out_format)?);
-    }
-    levels.reverse();
-    let note = (clipped > 0).then(|| {
-        format!(
-            "{clipped} of {texels} texels (all levels) hold values outside 0..1 and are clipped \
-             to the {} range; keep a float output (.exr, or --type f16) to keep them",
-            out_format.channel_type
-        )
-    });
-    Ok((levels, note))
-}
-
-/// Texels with a channel outside [0, 1] (or NaN).
-fn outside_unit_range(l: &Texture) -> u64 {
-    let ch = l.channels();
-    let count = |v: &[f32]| {
-        v.par_chunks(ch * 4096)
-            .map(|rows| {
-                rows.chunks_exact(ch)
-                    .filter(|p| p.iter().any(|x| !(0.0..=1.0).contains(x)))
-                    .count() as u64
-            })
-            .sum::<u64>()
-    };
-    match l.texels() {
-        Texels::F32(v) => count(v),
-        Texels::F16(v) => {
-            let f: Vec<f32> = v.iter().map(|x| x.to_f32()).collect();
-            count(&f)
-        }
-        _ => 0,
-    }
-}
-
-/// Change the alpha association of a level built in linear f32 (see
-/// `process`): premultiply, or divide colour by alpha (where alpha is 0
-/// the colour is kept, as oiiotool's --unpremult does).
-fn associate(mut l: Texture, association: Option<AlphaMode>) -> anyhow::Result<Texture> {
-    let Some(to) = association else {
-        return Ok(l);
-    };
-    let ch = l.channels();
-    let Texels::F32(v) = l.texels_mut() else {
-        anyhow::bail!("changing the alpha association needs f32 levels");
-    };
-    let premultiply = to == AlphaMode::Premultiplied;
-    v.par_chunks_mut(ch * 4096).for_each(|rows| {
-        for px in rows.chunks_exact_mut(ch) {
-            let a = px[ch - 1];
-            if premultiply {
-                px[..ch - 1].iter_mut().for_each(|c| *c *= a);
-            } else if a != 0.0 {
-                px[..ch - 1].iter_mut().for_each(|c| *c /= a);
-            }
-        }
-    });
-    let f = l.format().with_alpha(to);
-    Ok(l.reinterpret(f)?)
-}
-
-/// Convert a built level to the output format (type, colour space, and
-/// channel widening for containers that need it).
-fn convert_level(l: Texture, out: Format) -> anyhow::Result<Texture> {
-    let narrow = Format {
-        channels: l.format().channels,
-        ..out
-    };
-    let conv = if l.format() == narrow {
-        l
-    } else if l.channel_type() == ChannelType::F32
-        && l.format().color_space == ColorSpace::Linear
-        && narrow.channel_type == ChannelType::F16
-        && narrow.color_space == ColorSpace::Linear
-    {
-        f32_to_f16(&l, narrow)?
-    } else {
-        l.convert(narrow)?
-    };
-    Ok(if conv.format().channels != out.channels {
-        io::expand_channels(&conv, out.channels)?
-    } else {
-        conv
-    })
-}
-
-/// Linear f32 → linear f16 without the general path's extra copy; finite
-/// values beyond the half range saturate (as `encode_from_linear` does).
-fn f32_to_f16(l: &Texture, f: Format) -> anyhow::Result<Texture> {
-    use half::slice::HalfFloatSliceExt;
-    let Texels::F32(v) = l.texels() else {
-        anyhow::bail!("expected f32 texels");
-    };
-    let mut out = vec![half::f16::ZERO; v.len()];
-    out.par_chunks_mut(1 << 16)
-        .zip(v.par_chunks(1 << 16))
-        .for_each(|(o, i)| {
-            o.convert_from_f32_slice(i);
-            for (o, &i) in o.iter_mut().zip(i) {
-                if i.is_finite() && o.is_infinite() {
-                    *o = if i > 0.0 {
-                        half::f16::MAX
-                    } else {
-                        half::f16::MIN
-                    };
-                }
-            }
-        });
-    Ok(Texture::from_f16(l.width(), l.height(), f, out)?)
 }
 
 fn summary_line(job: &Job, o: &Outcome, args: &MipArgs, secs: f64) -> String {

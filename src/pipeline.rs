@@ -1,0 +1,720 @@
+//! The batch mip pipeline behind `parvo mip`, for engines and asset
+//! pipelines that embed parvo: a job list in, one [`Outcome`] (or error)
+//! per job out, with the same planning, `--update` fingerprint rule and
+//! conversions as the command line.
+//!
+//! Per job: load (with decoder limits) → interpret the input (colour
+//! space, alpha) → resolve the output format for the container →
+//! fingerprint (skip when the output already stores it and
+//! [`Settings::update`] is set) → build the chain → convert each level to
+//! the output type → write atomically. [`run`] runs a batch in parallel,
+//! catches panics as per-job errors and refuses two jobs with one output.
+//!
+//! Type conversion: when the output type differs from the source (the
+//! common 8-bit sRGB PNG → half EXR), level 0 is decoded once to linear
+//! f32, the chain is built in f32 and each level is quantised once at the
+//! end. Building in the source type would round every intermediate level
+//! to 8 bits; decoding first costs memory (4 bytes per channel) but is the
+//! most accurate, and the f32 box path is the fastest one.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::io::exr::ExrCompression;
+use crate::io::{self, FileFormat, Limits, LoadOptions, OutputKind, SaveOptions};
+use crate::mip::{self, MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
+use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
+use crate::texture::Texture;
+use crate::wrap::Wrap;
+
+/// How to read the input's colour.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ColorChoice {
+    /// What the file says (see [`crate::io::load`]); linear for normal maps.
+    #[default]
+    Auto,
+    /// Linear, whatever the file says.
+    Linear,
+    /// sRGB-encoded, whatever the file says.
+    Srgb,
+}
+
+/// How to read the input's alpha channel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AlphaChoice {
+    /// What the file says.
+    #[default]
+    Auto,
+    /// Unassociated.
+    Straight,
+    /// Associated (premultiplied).
+    Premultiplied,
+    /// Not alpha: a data channel.
+    None,
+}
+
+/// The container of a batch's outputs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Extension {
+    /// Tiled, mip-mapped OpenEXR.
+    #[default]
+    Exr,
+    /// KTX2.
+    Ktx2,
+    /// DDS.
+    Dds,
+    /// One PNG per level (`NAME_{level}.png`).
+    Png,
+}
+
+/// Everything a job needs besides its input and output.
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// The mip filter.
+    pub filter: MipFilter,
+    /// Wrap modes; `None` takes the file's (repeat when it records none).
+    pub wrap: Option<Wrap>,
+    /// Level size rounding.
+    pub rounding: Rounding,
+    /// At most this many levels (including level 0); `None`: the full chain.
+    pub levels: Option<u32>,
+    /// Alpha coverage to preserve, in (0, 1).
+    pub alpha_coverage: Option<f32>,
+    /// The input is a normal map (see [`crate::mip::normal`]).
+    pub normal_map: bool,
+    /// What to do with NaN and infinite texels.
+    pub nan_policy: NanPolicy,
+    /// How to read the input's colour.
+    pub color: ColorChoice,
+    /// How to read the input's alpha.
+    pub alpha: AlphaChoice,
+    /// The output channel type; `None`: the container's default for the
+    /// source.
+    pub out_type: Option<ChannelType>,
+    /// EXR tile size.
+    pub tile: (u32, u32),
+    /// EXR compression.
+    pub compression: ExrCompression,
+    /// Choices the loader cannot make from the file.
+    pub load: LoadOptions,
+    /// Decoder limits.
+    pub limits: Limits,
+    /// Skip a job whose output stores this run's fingerprint.
+    pub update: bool,
+    /// Plan only: nothing is built or written.
+    pub dry_run: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            filter: MipFilter::Box,
+            wrap: None,
+            rounding: Rounding::Down,
+            levels: None,
+            alpha_coverage: None,
+            normal_map: false,
+            nan_policy: NanPolicy::Error,
+            color: ColorChoice::Auto,
+            alpha: AlphaChoice::Auto,
+            out_type: None,
+            tile: (64, 64),
+            compression: ExrCompression::default(),
+            load: LoadOptions::default(),
+            limits: Limits::default(),
+            update: false,
+            dry_run: false,
+        }
+    }
+}
+
+/// One job: an input (a file or a `builtin:` name) and where it goes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Job {
+    /// The input.
+    pub input: String,
+    /// The output path (a `{level}` template for PNG levels).
+    pub output: PathBuf,
+    /// The output container.
+    pub kind: OutputKind,
+}
+
+impl Job {
+    /// A job writing `output`, its container from the extension.
+    pub fn new(input: &str, output: &Path) -> Result<Job> {
+        Ok(Job {
+            input: input.to_string(),
+            output: output.to_path_buf(),
+            kind: OutputKind::from_path(output)?,
+        })
+    }
+
+    /// A batch into `dir`: each input's file stem (a `builtin:` name with
+    /// `:` as `-`) with the extension's suffix.
+    pub fn batch(inputs: &[String], dir: &Path, ext: Extension) -> Vec<Job> {
+        inputs
+            .iter()
+            .map(|input| {
+                let stem = if crate::builtin::is_builtin(input) {
+                    input.replace(':', "-")
+                } else {
+                    Path::new(input)
+                        .file_stem()
+                        .map(|s| s.to_string_lossy().into_owned())
+                        .unwrap_or_else(|| "output".into())
+                };
+                let (output, kind) = match ext {
+                    Extension::Exr => (dir.join(format!("{stem}.exr")), OutputKind::Exr),
+                    Extension::Ktx2 => (dir.join(format!("{stem}.ktx2")), OutputKind::Ktx2),
+                    Extension::Dds => (dir.join(format!("{stem}.dds")), OutputKind::Dds),
+                    Extension::Png => (
+                        dir.join(format!("{stem}_{{level}}.png")),
+                        OutputKind::PngLevels,
+                    ),
+                };
+                Job {
+                    input: input.clone(),
+                    output,
+                    kind,
+                }
+            })
+            .collect()
+    }
+}
+
+/// The checks that need no input read: option ranges, a channel type the
+/// container cannot store, round-up sizes where the container fixes them.
+/// The command line reports these as usage errors.
+pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
+    let bad = |m: String| Err(Error::InvalidOption(m));
+    if s.levels == Some(0) {
+        return bad("--levels must be at least 1".into());
+    }
+    if let Some(r) = s.alpha_coverage
+        && !(r > 0.0 && r < 1.0)
+    {
+        return bad(format!("--alpha-coverage {r}: must be between 0 and 1"));
+    }
+    if let Some(t) = s.out_type
+        && let Some(j) = jobs.iter().find(|j| !j.kind.supports(t))
+    {
+        return bad(format!(
+            "--type {t}: {} cannot store {t} texels (EXR: f16, f32; PNG: u8, u16; KTX2 and DDS: all)",
+            j.kind.name()
+        ));
+    }
+    if s.rounding == Rounding::Up
+        && let Some(j) = jobs
+            .iter()
+            .find(|j| matches!(j.kind, OutputKind::Ktx2 | OutputKind::Dds))
+    {
+        return bad(format!(
+            "--rounding up: {} defines its level sizes as floor(size / 2^k); \
+             use .exr or PNG levels for rounded-up chains (output {})",
+            if j.kind == OutputKind::Ktx2 {
+                "KTX2"
+            } else {
+                "DDS"
+            },
+            j.output.display()
+        ));
+    }
+    Ok(())
+}
+
+/// What happened to one job.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// The output was written.
+    Written,
+    /// The output already stores this run's fingerprint.
+    UpToDate,
+    /// A dry run: nothing was built or written.
+    DryRun,
+}
+
+impl Status {
+    /// The name reports use (`written`, `up to date`, `dry run`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Status::Written => "written",
+            Status::UpToDate => "up to date",
+            Status::DryRun => "dry run",
+        }
+    }
+}
+
+/// The result of one job.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// Where it went.
+    pub output: PathBuf,
+    /// What happened.
+    pub status: Status,
+    /// Level 0's size.
+    pub width: u32,
+    /// Level 0's size.
+    pub height: u32,
+    /// The output texel format.
+    pub format: Format,
+    /// Every level's size.
+    pub level_sizes: Vec<(u32, u32)>,
+    /// Seconds reading the input.
+    pub read_s: f64,
+    /// Seconds building the chain.
+    pub build_s: f64,
+    /// Seconds writing the output.
+    pub write_s: f64,
+    /// What the loader or the build did that the user would not assume.
+    pub notes: Vec<String>,
+}
+
+/// Progress of one job.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The build starts: this many texels of levels above 0 to make.
+    Building {
+        /// Texels of all levels above 0.
+        total_texels: u64,
+    },
+    /// Texels made so far.
+    Built {
+        /// Texels of levels above 0 made so far.
+        texels_done: u64,
+    },
+    /// The output is being written.
+    Writing,
+}
+
+/// The output texel format for a source format, container and settings.
+pub fn output_format(src: Format, kind: OutputKind, s: &Settings) -> Result<Format> {
+    let ty = match s.out_type {
+        Some(t) => t,
+        None => match kind {
+            OutputKind::Exr if src.channel_type == ChannelType::F32 => ChannelType::F32,
+            OutputKind::Exr => ChannelType::F16,
+            OutputKind::PngLevels if src.channel_type == ChannelType::U8 => ChannelType::U8,
+            OutputKind::PngLevels => ChannelType::U16,
+            OutputKind::Ktx2 | OutputKind::Dds => src.channel_type,
+        },
+    };
+    if !kind.supports(ty) {
+        return Err(Error::InvalidOption(format!(
+            "{} cannot store {ty} texels (EXR: f16, f32; PNG: u8, u16)",
+            kind.name()
+        )));
+    }
+    // Floats are linear light; integer outputs keep the source's encoding
+    // (a float source gives linear integers).
+    let cs = if ty.is_float() || src.channel_type.is_float() {
+        ColorSpace::Linear
+    } else {
+        src.color_space
+    };
+    // Each container's alpha convention: OpenEXR defines colour as
+    // associated with alpha, PNG as unassociated; KTX2 and DDS say which in
+    // their headers, so they keep the source's.
+    let alpha = match kind {
+        OutputKind::Exr if src.has_alpha() => AlphaMode::Premultiplied,
+        OutputKind::PngLevels if src.has_alpha() => AlphaMode::Straight,
+        _ => src.alpha,
+    };
+    let f = Format::new(src.channels, ty, cs).with_alpha(alpha);
+    Ok(match kind {
+        OutputKind::Ktx2 => io::ktx2::storable(f),
+        OutputKind::Dds => io::dds::storable(f),
+        _ => f,
+    })
+}
+
+/// The text the fingerprint hashes beside level 0: every setting that
+/// changes the output's bytes.
+pub fn fingerprint_text(s: &Settings, opts: &MipOptions, out: &Format, kind: OutputKind) -> String {
+    format!(
+        "parvo {} filter={} wrap={},{} rounding={} levels={} coverage={:?} normal={} fixnan={} out={out} kind={kind:?} tile={}x{} compression={}",
+        env!("CARGO_PKG_VERSION"),
+        opts.filter,
+        opts.wrap.u,
+        opts.wrap.v,
+        opts.rounding,
+        opts.max_levels
+            .map_or("full".to_string(), |n| n.to_string()),
+        opts.alpha_coverage,
+        opts.normal_map,
+        opts.nan_policy,
+        s.tile.0,
+        s.tile.1,
+        s.compression,
+    )
+}
+
+/// Runs one job (see the module docs), reporting progress to `progress`
+/// on the calling thread.
+pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Result<Outcome> {
+    let t_read = Instant::now();
+    let loaded = io::load_with(&job.input, &s.limits, &s.load)?;
+    let src_kind = loaded.info.format;
+    let file_wrap = loaded.info.wrap;
+    let mut notes = loaded.info.notes.clone();
+    let channel_names = loaded.info.channel_names.clone();
+    let mut base = loaded.into_base();
+    // Interpretation of the input.
+    let mut src = base.format();
+    src.color_space = match (s.color, s.normal_map) {
+        (ColorChoice::Linear, _) | (ColorChoice::Auto, true) => ColorSpace::Linear,
+        (ColorChoice::Srgb, _) => ColorSpace::Srgb,
+        // The loader's reading of the file (see io::load).
+        (ColorChoice::Auto, false) => src.color_space,
+    };
+    src.alpha = match s.alpha {
+        // A normal map's fourth channel is data, not alpha.
+        _ if s.normal_map => AlphaMode::None,
+        AlphaChoice::Auto => src.alpha,
+        AlphaChoice::Straight => AlphaMode::Straight,
+        AlphaChoice::Premultiplied => AlphaMode::Premultiplied,
+        AlphaChoice::None => AlphaMode::None,
+    };
+    base = base.reinterpret(src)?;
+    let read_s = t_read.elapsed().as_secs_f64();
+
+    let out_format = output_format(src, job.kind, s)?;
+    let options = MipOptions {
+        filter: s.filter,
+        wrap: s.wrap.or(file_wrap).unwrap_or_default(),
+        rounding: s.rounding,
+        max_levels: s.levels,
+        alpha_coverage: s.alpha_coverage,
+        alpha_store: Some(out_format.channel_type),
+        normal_map: s.normal_map,
+        nan_policy: s.nan_policy,
+        fast_paths: true,
+    };
+    if job.kind == OutputKind::Exr {
+        let full = mip::level_count(base.width(), base.height(), s.rounding, None);
+        if s.levels.is_some_and(|n| n < full) {
+            return Err(Error::InvalidOption(format!(
+                "a mip-mapped OpenEXR file holds the full chain ({full} levels); --levels applies to .ktx2, .dds and PNG"
+            )));
+        }
+    }
+    let level_sizes = mip::level_sizes(base.width(), base.height(), s.rounding, s.levels);
+    let (width, height) = (base.width(), base.height());
+    let fingerprint = io::fingerprint(&base, &fingerprint_text(s, &options, &out_format, job.kind));
+    let skipped = |status| Outcome {
+        output: job.output.clone(),
+        status,
+        width,
+        height,
+        format: out_format,
+        level_sizes: level_sizes.clone(),
+        read_s,
+        build_s: 0.0,
+        write_s: 0.0,
+        notes: notes.clone(),
+    };
+    if s.dry_run {
+        return Ok(skipped(Status::DryRun));
+    }
+    if s.update
+        && io::stored_fingerprint(&job.output, job.kind).as_deref() == Some(fingerprint.as_str())
+    {
+        return Ok(skipped(Status::UpToDate));
+    }
+
+    let t_build = Instant::now();
+    let total_texels: u64 = level_sizes[1..]
+        .iter()
+        .map(|&(w, h)| w as u64 * h as u64)
+        .sum();
+    progress(Stage::Building { total_texels });
+    let mut on_progress = |p: mip::Progress| {
+        progress(Stage::Built {
+            texels_done: p.texels_done,
+        })
+    };
+    let association =
+        (out_format.has_alpha() && src.alpha != out_format.alpha).then_some(out_format.alpha);
+    // Alpha coverage is matched on the unrounded filtered alpha (rounding
+    // each level to 8 bits first would tie texels the test must separate),
+    // so it always builds in f32.
+    let same = src.channel_type == out_format.channel_type
+        && src.color_space == out_format.color_space
+        && association.is_none()
+        && s.alpha_coverage.is_none();
+    let levels = if s.normal_map {
+        // Decoded to vectors, averaged in f32, encoded once per level into
+        // the output type (crate::mip::normal).
+        mip::normal::build(base, &options, out_format, &mut on_progress)?
+    } else {
+        let (levels, clip_note) = build_colour(
+            base,
+            &options,
+            src,
+            out_format,
+            association,
+            same,
+            &mut on_progress,
+        )?;
+        notes.extend(clip_note);
+        levels
+    };
+    let build_s = t_build.elapsed().as_secs_f64();
+    progress(Stage::Writing);
+
+    let t_write = Instant::now();
+    let save = SaveOptions {
+        // An EXR source's channel names carry to EXR output (N.X stays
+        // N.X, a lone Z stays Z); other sources get the layout's names.
+        channel_names: (src_kind == FileFormat::Exr
+            && channel_names.len() == out_format.channels as usize)
+            .then_some(channel_names),
+        wrap: options.wrap,
+        tile: s.tile,
+        compression: s.compression,
+        fingerprint: Some(fingerprint),
+        attributes: vec![
+            ("parvo:filter".into(), s.filter.to_string()),
+            ("parvo:source".into(), src.to_string()),
+            ("parvo:rounding".into(), s.rounding.to_string()),
+        ],
+    };
+    io::save(&levels, s.rounding, &job.output, job.kind, &save)?;
+    if job.kind == OutputKind::PngLevels {
+        // Levels an earlier, longer chain left behind under this template.
+        let stale = io::png_levels::remove_stale(&job.output, levels.len())?;
+        let list = |v: &[PathBuf]| {
+            v.iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        if !stale.removed.is_empty() {
+            notes.push(format!(
+                "removed {} stale level file(s) of an earlier run: {}",
+                stale.removed.len(),
+                list(&stale.removed)
+            ));
+        }
+        if !stale.foreign.is_empty() {
+            notes.push(format!(
+                "left alone (not written by parvo): {}",
+                list(&stale.foreign)
+            ));
+        }
+    }
+    let write_s = t_write.elapsed().as_secs_f64();
+    Ok(Outcome {
+        output: job.output.clone(),
+        status: Status::Written,
+        width,
+        height,
+        format: out_format,
+        level_sizes,
+        read_s,
+        build_s,
+        write_s,
+        notes,
+    })
+}
+
+/// Runs `jobs`: in parallel when there is more than one, each job's result
+/// handed to `done` as it finishes (from any thread). A panic in a job is
+/// its error (`internal error: …`); a job whose output is another job's is
+/// refused. A single job reports its progress to `progress`.
+pub fn run(
+    jobs: &[Job],
+    s: &Settings,
+    progress: &mut (dyn FnMut(Stage) + Send),
+    done: &(dyn Fn(&Job, Result<Outcome>) + Sync),
+) {
+    // Two inputs with the same output name would overwrite each other.
+    let mut seen = std::collections::HashMap::new();
+    let dup: Vec<Option<String>> = jobs
+        .iter()
+        .map(|j| seen.insert(j.output.clone(), j.input.clone()))
+        .collect();
+    let one = |job: &Job, dup: &Option<String>, progress: &mut dyn FnMut(Stage)| {
+        let r = match dup {
+            Some(first) => Err(Error::InvalidOption(format!(
+                "output {} is also the output of {first}",
+                job.output.display()
+            ))),
+            None => {
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| process(job, s, progress)))
+                    .unwrap_or_else(|p| {
+                        Err(Error::InvalidOption(format!(
+                            "internal error: {}",
+                            io::atomic::panic_message(&*p)
+                        )))
+                    })
+            }
+        };
+        done(job, r);
+    };
+    if jobs.len() > 1 {
+        jobs.par_iter()
+            .zip(dup.par_iter())
+            .for_each(|(j, d)| one(j, d, &mut |_| {}));
+    } else {
+        for (j, d) in jobs.iter().zip(&dup) {
+            one(j, d, progress);
+        }
+    }
+}
+
+/// The colour chain: built in the source format when it is the output
+/// format, else in linear f32 from a single decode of level 0 (see the
+/// module docs), each level converted to the output format; with a note
+/// when float values were clipped to a normalised output.
+fn build_colour(
+    base: Texture,
+    options: &MipOptions,
+    src: Format,
+    out_format: Format,
+    association: Option<AlphaMode>,
+    same: bool,
+    progress: &mut dyn FnMut(mip::Progress),
+) -> Result<(Vec<Texture>, Option<String>)> {
+    let work_base = if same {
+        base
+    } else {
+        // Decode straight into the f32 buffer (`Texture::convert` would
+        // hold a second full-size f32 copy while encoding).
+        let f =
+            Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
+        let mut linear = vec![0f32; base.texels().len()];
+        crate::texel::decode_to_linear(&base.format(), base.texels(), &mut linear);
+        let (w, h) = (base.width(), base.height());
+        drop(base);
+        Texture::from_f32(w, h, f, linear)?
+    };
+    let chain: MipChain = mip::build_with_progress(work_base, options, progress)?;
+    // Float data (HDR) written to a normalised type is clipped to [0, 1]:
+    // count the texels that lose something, to say so once.
+    let count_clipped = src.channel_type.is_float() && !out_format.channel_type.is_float();
+    let mut clipped = 0u64;
+    let mut texels = 0u64;
+    // Smallest level first, so level 0's f32 and converted copies never
+    // coexist with the unconverted rest of the chain.
+    let mut levels: Vec<Texture> = Vec::with_capacity(chain.len());
+    for l in chain.into_levels().into_iter().rev() {
+        let l = associate(l, association)?;
+        if count_clipped {
+            clipped += outside_unit_range(&l);
+            texels += l.texel_count() as u64;
+        }
+        levels.push(convert_level(l, out_format)?);
+    }
+    levels.reverse();
+    let note = (clipped > 0).then(|| {
+        format!(
+            "{clipped} of {texels} texels (all levels) hold values outside 0..1 and are clipped \
+             to the {} range; keep a float output (.exr, or --type f16) to keep them",
+            out_format.channel_type
+        )
+    });
+    Ok((levels, note))
+}
+
+/// Texels with a channel outside [0, 1] (or NaN).
+fn outside_unit_range(l: &Texture) -> u64 {
+    let ch = l.channels();
+    let count = |v: &[f32]| {
+        v.par_chunks(ch * 4096)
+            .map(|rows| {
+                rows.chunks_exact(ch)
+                    .filter(|p| p.iter().any(|x| !(0.0..=1.0).contains(x)))
+                    .count() as u64
+            })
+            .sum::<u64>()
+    };
+    match l.texels() {
+        Texels::F32(v) => count(v),
+        Texels::F16(v) => {
+            let f: Vec<f32> = v.iter().map(|x| x.to_f32()).collect();
+            count(&f)
+        }
+        _ => 0,
+    }
+}
+
+/// Change the alpha association of a level built in linear f32:
+/// premultiply, or divide colour by alpha (where alpha is 0 the colour is
+/// kept, as oiiotool's --unpremult does).
+fn associate(mut l: Texture, association: Option<AlphaMode>) -> Result<Texture> {
+    let Some(to) = association else {
+        return Ok(l);
+    };
+    let ch = l.channels();
+    let Texels::F32(v) = l.texels_mut() else {
+        return Err(Error::InvalidOption(
+            "changing the alpha association needs f32 levels".into(),
+        ));
+    };
+    let premultiply = to == AlphaMode::Premultiplied;
+    v.par_chunks_mut(ch * 4096).for_each(|rows| {
+        for px in rows.chunks_exact_mut(ch) {
+            let a = px[ch - 1];
+            if premultiply {
+                px[..ch - 1].iter_mut().for_each(|c| *c *= a);
+            } else if a != 0.0 {
+                px[..ch - 1].iter_mut().for_each(|c| *c /= a);
+            }
+        }
+    });
+    let f = l.format().with_alpha(to);
+    l.reinterpret(f)
+}
+
+/// Convert a built level to the output format (type, colour space, and
+/// channel widening for containers that need it).
+fn convert_level(l: Texture, out: Format) -> Result<Texture> {
+    let narrow = Format {
+        channels: l.format().channels,
+        ..out
+    };
+    let conv = if l.format() == narrow {
+        l
+    } else if l.channel_type() == ChannelType::F32
+        && l.format().color_space == ColorSpace::Linear
+        && narrow.channel_type == ChannelType::F16
+        && narrow.color_space == ColorSpace::Linear
+    {
+        f32_to_f16(&l, narrow)?
+    } else {
+        l.convert(narrow)?
+    };
+    if conv.format().channels != out.channels {
+        io::expand_channels(&conv, out.channels)
+    } else {
+        Ok(conv)
+    }
+}
+
+/// Linear f32 → linear f16 without the general path's extra copy; finite
+/// values beyond the half range saturate (as `encode_from_linear` does).
+fn f32_to_f16(l: &Texture, f: Format) -> Result<Texture> {
+    use half::slice::HalfFloatSliceExt;
+    let Texels::F32(v) = l.texels() else {
+        return Err(Error::InvalidOption("expected f32 texels".into()));
+    };
+    let mut out = vec![half::f16::ZERO; v.len()];
+    out.par_chunks_mut(1 << 16)
+        .zip(v.par_chunks(1 << 16))
+        .for_each(|(o, i)| {
+            o.convert_from_f32_slice(i);
+            for (o, &i) in o.iter_mut().zip(i) {
+                if i.is_finite() && o.is_infinite() {
+                    *o = if i > 0.0 {
+                        half::f16::MAX
+                    } else {
+                        half::f16::MIN
+                    };
+                }
+            }
+        });
+    Texture::from_f16(l.width(), l.height(), f, out)
+}
