@@ -25,6 +25,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::io::exr::ExrCompression;
 use crate::io::{self, FileFormat, Limits, LoadOptions, OutputKind, SaveOptions};
+use crate::mip::roughness::{BaseRoughness, NormalChannels, Specular};
 use crate::mip::{self, MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
@@ -106,6 +107,34 @@ pub struct Settings {
     pub update: bool,
     /// Plan only: nothing is built or written.
     pub dry_run: bool,
+    /// Normal maps: a roughness (or Blinn-Phong exponent) chain from the
+    /// spread of the normals (see [`crate::mip::roughness`]).
+    pub roughness: Option<RoughnessSettings>,
+}
+
+/// Where a normal map's roughness comes from and where it goes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoughnessSettings {
+    /// The base roughness: a number, or a roughness map (a file or a
+    /// `builtin:` name) of the normal map's size.
+    pub base: RoughnessSource,
+    /// Which channels of the normal map hold the vector.
+    pub channels: NormalChannels,
+    /// Roughness α' or Blinn-Phong exponents s'.
+    pub specular: Specular,
+    /// A second output for the chain (one channel, linear), or `None`.
+    pub output: Option<(PathBuf, OutputKind)>,
+    /// Store the chain in the normal output's alpha channel instead.
+    pub pack_alpha: bool,
+}
+
+/// The base roughness of a roughness chain.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RoughnessSource {
+    /// One roughness in [0, 1].
+    Constant(f32),
+    /// A roughness map, loaded with the job's limits.
+    Map(String),
 }
 
 impl Default for Settings {
@@ -127,6 +156,7 @@ impl Default for Settings {
             limits: Limits::default(),
             update: false,
             dry_run: false,
+            roughness: None,
         }
     }
 }
@@ -206,9 +236,62 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
             j.kind.name()
         ));
     }
+    if let Some(r) = &s.roughness {
+        if !s.normal_map {
+            return bad("a roughness chain is made from a normal map: add --normal-map".into());
+        }
+        if jobs.len() > 1 && r.output.is_some() {
+            return bad("--roughness-out names one file: use it with -o (one input)".into());
+        }
+        if r.pack_alpha && r.output.is_some() {
+            return bad(
+                "--pack-roughness stores the roughness in the normal output: drop --roughness-out"
+                    .into(),
+            );
+        }
+        if !r.pack_alpha && r.output.is_none() {
+            return bad("give --roughness-out FILE or --pack-roughness A for the roughness".into());
+        }
+        if let RoughnessSource::Constant(a) = r.base
+            && !(0.0..=1.0).contains(&a)
+        {
+            return bad(format!("--roughness {a}: must be from 0 to 1"));
+        }
+        if s.alpha_coverage.is_some() {
+            return bad("--alpha-coverage does not apply to normal maps".into());
+        }
+        // Exponents are not unorm values.
+        if let Specular::BlinnPhong(_) = r.specular {
+            let float = |kind: OutputKind| match s.out_type {
+                Some(t) => t.is_float() && kind.supports(t),
+                None => kind == OutputKind::Exr,
+            };
+            let kinds: Vec<OutputKind> = match &r.output {
+                Some((_, k)) => vec![*k],
+                None => jobs.iter().map(|j| j.kind).collect(),
+            };
+            if kinds.iter().any(|&k| !float(k)) {
+                return bad(
+                    "--specular blinn-phong writes exponents above 1: the chain needs a float \
+                     output (.exr, or --type f16/f32 with .ktx2/.dds)"
+                        .into(),
+                );
+            }
+        }
+    }
+    let rough_out = s
+        .roughness
+        .as_ref()
+        .and_then(|r| r.output.clone())
+        .map(|(output, kind)| Job {
+            input: String::new(),
+            output,
+            kind,
+        });
     if s.rounding == Rounding::Up
         && let Some(j) = jobs
             .iter()
+            .chain(&rough_out)
             .find(|j| matches!(j.kind, OutputKind::Ktx2 | OutputKind::Dds))
     {
         return bad(format!(
@@ -348,7 +431,13 @@ pub fn fingerprint_text(s: &Settings, opts: &MipOptions, out: &Format, kind: Out
         s.tile.0,
         s.tile.1,
         s.compression,
-    )
+    ) + &match &s.roughness {
+        Some(r) => format!(
+            " roughness={:?} channels={:?} specular={:?} pack={} rough_out={:?}",
+            r.base, r.channels, r.specular, r.pack_alpha, r.output
+        ),
+        None => String::new(),
+    }
 }
 
 /// Runs one job (see the module docs), reporting progress to `progress`
@@ -380,7 +469,24 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     base = base.reinterpret(src)?;
     let read_s = t_read.elapsed().as_secs_f64();
 
-    let out_format = output_format(src, job.kind, s)?;
+    let out_format = match &s.roughness {
+        // The normal output holds the vectors (and, packed, the roughness
+        // in alpha): three or four channels whatever the source has.
+        Some(r) => {
+            if r.pack_alpha && src.channels == 4 {
+                return Err(Error::InvalidOption(
+                    "the normal map has a fourth channel; --pack-roughness would overwrite it \
+                     (write the roughness with --roughness-out instead)"
+                        .into(),
+                ));
+            }
+            let n = if r.pack_alpha { 4 } else { 3 };
+            let f =
+                Format::new(n, src.channel_type, ColorSpace::Linear).with_alpha(AlphaMode::None);
+            output_format(f, job.kind, s)?
+        }
+        None => output_format(src, job.kind, s)?,
+    };
     let options = MipOptions {
         filter: s.filter,
         wrap: s.wrap.or(file_wrap).unwrap_or_default(),
@@ -418,8 +524,14 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     if s.dry_run {
         return Ok(skipped(Status::DryRun));
     }
+    let stored =
+        |p: &Path, k| io::stored_fingerprint(p, k).as_deref() == Some(fingerprint.as_str());
     if s.update
-        && io::stored_fingerprint(&job.output, job.kind).as_deref() == Some(fingerprint.as_str())
+        && stored(&job.output, job.kind)
+        && s.roughness
+            .as_ref()
+            .and_then(|r| r.output.as_ref())
+            .is_none_or(|(p, k)| stored(p, *k))
     {
         return Ok(skipped(Status::UpToDate));
     }
@@ -444,7 +556,13 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         && src.color_space == out_format.color_space
         && association.is_none()
         && s.alpha_coverage.is_none();
-    let levels = if s.normal_map {
+    let mut rough_levels = None;
+    let levels = if let Some(r) = &s.roughness {
+        let (normals, chain) =
+            build_roughness(&base, r, s, &options, out_format, &mut on_progress)?;
+        rough_levels = chain;
+        normals
+    } else if s.normal_map {
         // Decoded to vectors, averaged in f32, encoded once per level into
         // the output type (crate::mip::normal).
         mip::normal::build(base, &options, out_format, &mut on_progress)?
@@ -482,6 +600,15 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         ],
     };
     io::save(&levels, s.rounding, &job.output, job.kind, &save)?;
+    if let (Some(levels), Some(r)) = (rough_levels, &s.roughness)
+        && let Some((path, kind)) = &r.output
+    {
+        let rs = SaveOptions {
+            channel_names: (*kind == OutputKind::Exr).then(|| vec!["Y".to_string()]),
+            ..save.clone()
+        };
+        io::save(&levels, s.rounding, path, *kind, &rs)?;
+    }
     if job.kind == OutputKind::PngLevels {
         // Levels an earlier, longer chain left behind under this template.
         let stale = io::png_levels::remove_stale(&job.output, levels.len())?;
@@ -563,6 +690,95 @@ pub fn run(
             one(j, d, progress);
         }
     }
+}
+
+/// The normal chain (encoded as `out`) and, unless packed into its
+/// alpha, the roughness chain encoded for its own output.
+fn build_roughness(
+    base: &Texture,
+    r: &RoughnessSettings,
+    s: &Settings,
+    options: &MipOptions,
+    out: Format,
+    progress: &mut dyn FnMut(mip::Progress),
+) -> Result<(Vec<Texture>, Option<Vec<Texture>>)> {
+    let map;
+    let base_rough = match &r.base {
+        RoughnessSource::Constant(a) => BaseRoughness::Constant(*a),
+        RoughnessSource::Map(name) => {
+            map = io::load_with(name, &s.limits, &s.load)?.into_base();
+            BaseRoughness::Map(&map)
+        }
+    };
+    let opts = MipOptions {
+        normal_map: false,
+        alpha_store: None,
+        ..*options
+    };
+    let chain = mip::roughness::build(base, r.channels, base_rough, r.specular, &opts, progress)?;
+    let narrow = |f: Format, ch: u8| Format {
+        channels: ch,
+        alpha: AlphaMode::None,
+        ..f
+    };
+    let mut normals = Vec::with_capacity(chain.normals.len());
+    for (n, sp) in chain.normals.iter().zip(&chain.specular) {
+        let v = if r.pack_alpha {
+            let (Texels::F32(nv), Texels::F32(sv)) = (n.texels(), sp.texels()) else {
+                return Err(Error::InvalidOption("roughness chains are f32".into()));
+            };
+            let packed: Vec<f32> = nv
+                .chunks_exact(3)
+                .zip(sv)
+                .flat_map(|(n, a)| [n[0], n[1], n[2], *a])
+                .collect();
+            let f =
+                Format::new(4, ChannelType::F32, ColorSpace::Linear).with_alpha(AlphaMode::None);
+            Texture::from_f32(n.width(), n.height(), f, packed)?
+        } else {
+            n.clone()
+        };
+        let ch = v.format().channels;
+        let enc = mip::normal::encode(&v, narrow(out, ch))?;
+        normals.push(if out.channels != ch {
+            io::expand_channels(&enc, out.channels)?
+        } else {
+            enc
+        });
+    }
+    let rough = match &r.output {
+        None => None,
+        Some((_, kind)) => {
+            let ty = match s.out_type {
+                Some(t) if kind.supports(t) => t,
+                _ => match kind {
+                    OutputKind::Exr => ChannelType::F16,
+                    OutputKind::PngLevels if out.channel_type == ChannelType::U16 => {
+                        ChannelType::U16
+                    }
+                    OutputKind::PngLevels => ChannelType::U8,
+                    OutputKind::Ktx2 | OutputKind::Dds if kind.supports(out.channel_type) => {
+                        out.channel_type
+                    }
+                    _ => ChannelType::U8,
+                },
+            };
+            let f = Format::new(1, ty, ColorSpace::Linear).with_alpha(AlphaMode::None);
+            let f = match kind {
+                OutputKind::Ktx2 => io::ktx2::storable(f),
+                OutputKind::Dds => io::dds::storable(f),
+                _ => f,
+            };
+            Some(
+                chain
+                    .specular
+                    .into_iter()
+                    .map(|l| convert_level(l, f))
+                    .collect::<Result<Vec<_>>>()?,
+            )
+        }
+    };
+    Ok((normals, rough))
 }
 
 /// The colour chain: built in the source format when it is the output

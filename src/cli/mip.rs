@@ -20,9 +20,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use parvo::Wrap;
 use parvo::io::exr::ExrCompression;
 use parvo::io::{self, Limits, OutputKind};
+use parvo::mip::roughness::{NormalChannels, Specular};
 use parvo::mip::{MipFilter, NanPolicy, Rounding};
 use parvo::pipeline::{
-    self, AlphaChoice, ColorChoice, Extension, Job, Outcome, Settings, Stage, Status,
+    self, AlphaChoice, ColorChoice, Extension, Job, Outcome, RoughnessSettings, RoughnessSource,
+    Settings, Stage, Status,
 };
 use parvo::texel::ChannelType;
 
@@ -52,6 +54,27 @@ pub enum AlphaArg {
 }
 
 /// Output container for `--out-dir` batches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum NormalChannelsArg {
+    Xyz,
+    Xy,
+}
+
+fn parse_specular(s: &str) -> Result<Specular, String> {
+    if s == "roughness" {
+        return Ok(Specular::Roughness);
+    }
+    match s.split_once(':') {
+        Some(("blinn-phong", e)) => match e.parse::<f32>() {
+            Ok(x) if x > 0.0 && x.is_finite() => Ok(Specular::BlinnPhong(x)),
+            _ => Err(format!("`{e}` is not a Blinn-Phong exponent above 0")),
+        },
+        _ => Err(format!(
+            "`{s}`: expected roughness or blinn-phong:EXP (e.g. blinn-phong:64)"
+        )),
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ExtArg {
     /// Tiled, mip-mapped OpenEXR.
@@ -131,6 +154,49 @@ pub struct MipArgs {
     /// Treat RGB as unit normals: load as linear and renormalise each level.
     #[arg(long)]
     normal_map: bool,
+
+    /// Normal maps: also build a roughness chain from the spread of the normals, from this base roughness.
+    #[arg(
+        long,
+        value_name = "NUM|TEXTURE",
+        requires = "normal_map",
+        long_help = "Normal maps: build a roughness chain beside the normal chain, so that distant, \
+        averaged bumps keep their specular look (SPEC.md: each texel's mean of the unit level-0 normals \
+        of its footprint has length r; kappa = (3r - r^3) / (1 - r^2); roughness' = sqrt(roughness^2 + \
+        2 / kappa), at most 1). The base roughness is a number from 0 to 1 (Beckmann m or GGX alpha) or \
+        a roughness map of the normal map's size (its first channel, read as data). Write the chain \
+        with --roughness-out or --pack-roughness A. With it the normal output has three channels (four \
+        packed)."
+    )]
+    roughness: Option<String>,
+
+    /// Where the roughness chain goes: any output parvo writes (one channel, linear).
+    #[arg(
+        long,
+        value_name = "OUTPUT",
+        requires = "roughness",
+        long_help = "The roughness chain's output: .exr, .ktx2, .dds or NAME_{level}.png; one channel, \
+        linear, in the main output's --type where the container stores it (else f16 for EXR, u8/u16 for \
+        PNG and 8-bit for KTX2/DDS), with the same level sizes, wrap modes and fingerprint."
+    )]
+    roughness_out: Option<PathBuf>,
+
+    /// Store the roughness chain in the normal output's alpha channel (A) instead of a second file.
+    #[arg(
+        long,
+        value_name = "A",
+        requires = "roughness",
+        conflicts_with = "roughness_out"
+    )]
+    pack_roughness: Option<String>,
+
+    /// Which channels of a normal map hold the vector: xyz, or xy (z rebuilt as sqrt(1 - x^2 - y^2)).
+    #[arg(long, value_enum, default_value = "xyz", value_name = "CH")]
+    normal_map_channels: NormalChannelsArg,
+
+    /// With --roughness: roughness (default) or blinn-phong:EXP (Toksvig's exponent chain from base exponent EXP).
+    #[arg(long, default_value = "roughness", value_name = "MODEL", value_parser = parse_specular, requires = "roughness")]
+    specular: Specular,
 
     /// Wrap modes for the filter taps and the file: MODE or U,V (repeat, mirror, clamp, border, mirror-clamp).
     #[arg(
@@ -332,7 +398,56 @@ fn settings(args: &MipArgs) -> Settings {
         },
         update: args.update,
         dry_run: args.dry_run,
+        roughness: None,
     }
+}
+
+/// The roughness settings of these arguments (a usage error as text).
+fn roughness_settings(args: &MipArgs) -> Result<Option<RoughnessSettings>, String> {
+    let channels = match args.normal_map_channels {
+        NormalChannelsArg::Xyz => NormalChannels::Xyz,
+        NormalChannelsArg::Xy => NormalChannels::Xy,
+    };
+    let Some(r) = &args.roughness else {
+        if channels == NormalChannels::Xy {
+            return Err(
+                "--normal-map-channels xy needs --roughness (the roughness path rebuilds z)".into(),
+            );
+        }
+        return Ok(None);
+    };
+    let base = match r.trim().parse::<f32>() {
+        Ok(a) => RoughnessSource::Constant(a),
+        Err(_) if parvo::builtin::is_builtin(r) || std::path::Path::new(r).is_file() => {
+            RoughnessSource::Map(r.clone())
+        }
+        Err(_) => {
+            return Err(format!(
+                "--roughness {r}: neither a number from 0 to 1 nor a texture file"
+            ));
+        }
+    };
+    if let Some(p) = &args.pack_roughness
+        && !p.eq_ignore_ascii_case("a")
+    {
+        return Err(format!(
+            "--pack-roughness {p}: only A (the alpha channel) is supported"
+        ));
+    }
+    let output = match &args.roughness_out {
+        Some(p) => Some((
+            p.clone(),
+            OutputKind::from_path(p).map_err(|e| e.to_string())?,
+        )),
+        None => None,
+    };
+    Ok(Some(RoughnessSettings {
+        base,
+        channels,
+        specular: args.specular,
+        output,
+        pack_alpha: args.pack_roughness.is_some(),
+    }))
 }
 
 pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
@@ -365,7 +480,11 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
         (None, Some(dir)) => Job::batch(&args.inputs, dir, args.ext.into()),
         _ => return usage("give -o OUTPUT (one input) or --out-dir DIR (a batch)".into()),
     };
-    let settings = settings(&args);
+    let mut settings = settings(&args);
+    match roughness_settings(&args) {
+        Ok(r) => settings.roughness = r,
+        Err(e) => return usage(e),
+    }
     // Usage errors, found before any input is read.
     if let Err(e) = pipeline::check(&jobs, &settings) {
         return usage(e.to_string());
@@ -484,8 +603,13 @@ fn summary_line(job: &Job, o: &Outcome, args: &MipArgs, secs: f64) -> String {
         Status::UpToDate => " (up to date)",
         Status::DryRun => " (dry run: nothing written)",
     };
+    let rough = match (&args.roughness_out, &args.pack_roughness) {
+        (Some(p), _) => format!(", roughness -> {}", p.display()),
+        (None, Some(_)) => ", roughness in A".to_string(),
+        _ => String::new(),
+    };
     format!(
-        "{} -> {out}: {}x{} {}, {} levels, {}{what}, {:.2} s",
+        "{} -> {out}: {}x{} {}, {} levels, {}{rough}{what}, {:.2} s",
         job.input,
         o.width,
         o.height,
