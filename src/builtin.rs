@@ -1,6 +1,7 @@
 //! Procedural textures, usable wherever a texture file is
-//! (`builtin:checker[:SIZE]`, `builtin:zoneplate[:SIZE]`), so every command
-//! and test can run without files.
+//! (`builtin:checker[:SIZE]`, `builtin:zoneplate[:SIZE]`,
+//! `builtin:bumps[:SIZE]`), so every command and test can run without
+//! files.
 //!
 //! - `checker`: an 8×8 board of sRGB RGBA8 squares alternating between two
 //!   colours (white and a mid red), square size `SIZE / 8` (at least 1).
@@ -9,6 +10,9 @@
 //!   frequency grows linearly with the radius and reaches the Nyquist limit
 //!   at the border, so every level of a pyramid shows how much aliasing a
 //!   filter lets through.
+//! - `bumps`: a normal map (linear RGB8 codes `(n + 1)/2`) of Gaussian
+//!   bumps at two scales ([`crate::shade::builtin_bumps`]), for roughness
+//!   chains and `parvo render --shade`.
 
 use crate::error::{Error, Result};
 use crate::texel::{ChannelType, ColorSpace, Format};
@@ -27,6 +31,8 @@ pub enum Builtin {
     Checker,
     /// Circular zone plate.
     ZonePlate,
+    /// A normal map of Gaussian bumps.
+    Bumps,
 }
 
 /// True if `name` names a built-in texture (starts with `builtin:`).
@@ -49,11 +55,12 @@ pub fn parse(name: &str) -> Result<(Builtin, u32)> {
     let kind = match parts.next().unwrap_or("") {
         "checker" => Builtin::Checker,
         "zoneplate" => Builtin::ZonePlate,
+        "bumps" => Builtin::Bumps,
         _ => {
             return Err(Error::parse(
                 "built-in texture",
                 name,
-                "known textures: builtin:checker[:SIZE], builtin:zoneplate[:SIZE]",
+                "known textures: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE]",
             ));
         }
     };
@@ -85,6 +92,7 @@ pub fn parse(name: &str) -> Result<(Builtin, u32)> {
 pub fn generate(kind: Builtin, size: u32) -> Result<Texture> {
     let n = size as usize;
     match kind {
+        Builtin::Bumps => crate::shade::builtin_bumps(size),
         Builtin::Checker => {
             let cell = (n / 8).max(1);
             let mut v = vec![0u8; n * n * 4];

@@ -17,15 +17,19 @@
 //! al. 2007) and, adjusted, Toksvig's `s'`.
 //!
 //! [`bumps`], [`v_grooves`] and [`height_field`] make the procedural
-//! normal maps the validation runs on.
+//! normal maps the validation runs on; [`render`] shades a normal-mapped
+//! scene three ways (ground truth, renormalised, adjusted) so the effect
+//! can be seen.
 
 use crate::error::{Error, Result};
 use crate::mip::roughness::{self, BaseRoughness, NormalChannels, Specular};
-use crate::mip::{MipFilter, MipOptions};
+use crate::mip::{MipChain, MipFilter, MipOptions};
 use crate::texel::{ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
 use std::f64::consts::PI;
+
+use rayon::prelude::*;
 
 /// A unit vector in the normal map's tangent space (z out of the surface).
 pub type Dir = [f64; 3];
@@ -225,19 +229,24 @@ fn f32s(t: &Texture) -> Result<&[f32]> {
 }
 
 /// The float normal map of a height field `height(x, y)` (texel units;
-/// central differences, wrapping), `size`².
-pub fn normals_of_height(size: u32, height: impl Fn(f64, f64) -> f64) -> Result<Texture> {
-    let s = size as f64;
-    let mut v = Vec::with_capacity((size * size * 3) as usize);
-    for y in 0..size {
-        for x in 0..size {
-            let (x, y) = (x as f64, y as f64);
-            let hx = (height((x + 1.0) % s, y) - height((x - 1.0 + s) % s, y)) * 0.5;
-            let hy = (height(x, (y + 1.0) % s) - height(x, (y - 1.0 + s) % s)) * 0.5;
-            let n = unit([-hx, -hy, 1.0]);
-            v.extend(n.map(|c| c as f32));
-        }
-    }
+/// central differences, wrapping), `size`². The heights are evaluated
+/// once per texel, rows in parallel.
+pub fn normals_of_height(size: u32, height: impl Fn(f64, f64) -> f64 + Sync) -> Result<Texture> {
+    let n = size as usize;
+    let h: Vec<f64> = (0..n * n)
+        .into_par_iter()
+        .map(|i| height((i % n) as f64, (i / n) as f64))
+        .collect();
+    let at = |x: usize, y: usize| h[(y % n) * n + (x % n)];
+    let v: Vec<f32> = (0..n * n)
+        .into_par_iter()
+        .flat_map_iter(|i| {
+            let (x, y) = (i % n, i / n);
+            let hx = (at(x + 1, y) - at(x + n - 1, y)) * 0.5;
+            let hy = (at(x, y + 1) - at(x, y + n - 1)) * 0.5;
+            unit([-hx, -hy, 1.0]).map(|c| c as f32)
+        })
+        .collect();
     Texture::from_f32(
         size,
         size,
@@ -262,29 +271,105 @@ impl Mix {
 /// Gaussian bumps of standard deviation `sigma` texels and height
 /// `height`·sigma at random places (`count` of them, wrapping), `size`².
 pub fn bumps(size: u32, sigma: f64, height: f64, count: usize, seed: u64) -> Result<Texture> {
+    let h = bump_height(size, sigma, height, count, seed);
+    normals_of_height(size, h)
+}
+
+/// The height field of [`bumps`]: each bump reaches 4σ, so the centres
+/// are binned in cells of at least 4σ and a point looks at the 3×3 cells
+/// around its own (wrapping).
+fn bump_height(
+    size: u32,
+    sigma: f64,
+    height: f64,
+    count: usize,
+    seed: u64,
+) -> impl Fn(f64, f64) -> f64 {
     let mut r = Mix(seed);
     let s = size as f64;
-    let centres: Vec<(f64, f64, f64)> = (0..count)
-        .map(|_| {
-            (
-                r.unit() * s,
-                r.unit() * s,
-                if r.unit() < 0.5 { -1.0 } else { 1.0 },
-            )
-        })
-        .collect();
-    normals_of_height(size, |x, y| {
+    let cells = ((s / (4.0 * sigma)).floor() as usize).max(1);
+    let cell = s / cells as f64;
+    let mut bins: Vec<Vec<(f64, f64, f64)>> = vec![Vec::new(); cells * cells];
+    for _ in 0..count {
+        let (cx, cy) = (r.unit() * s, r.unit() * s);
+        let sign = if r.unit() < 0.5 { -1.0 } else { 1.0 };
+        let (i, j) = (
+            ((cx / cell) as usize).min(cells - 1),
+            ((cy / cell) as usize).min(cells - 1),
+        );
+        bins[j * cells + i].push((cx, cy, sign));
+    }
+    move |x, y| {
+        let (i, j) = ((x / cell) as i64, (y / cell) as i64);
         let mut z = 0.0;
-        for &(cx, cy, sign) in &centres {
-            let dx = (x - cx + s * 1.5).rem_euclid(s) - s * 0.5;
-            let dy = (y - cy + s * 1.5).rem_euclid(s) - s * 0.5;
-            let d2 = dx * dx + dy * dy;
-            if d2 < 16.0 * sigma * sigma {
-                z += sign * height * sigma * (-d2 / (2.0 * sigma * sigma)).exp();
+        let near: &[i64] = if cells >= 3 { &[-1, 0, 1] } else { &[0] };
+        let mut seen = [usize::MAX; 9];
+        let mut k = 0;
+        for dj in near {
+            for di in near {
+                let ci = (i + di).rem_euclid(cells as i64) as usize;
+                let cj = (j + dj).rem_euclid(cells as i64) as usize;
+                let b = cj * cells + ci;
+                if seen[..k].contains(&b) {
+                    continue;
+                }
+                seen[k] = b;
+                k += 1;
+                for &(cx, cy, sign) in &bins[b] {
+                    let wrap = |d: f64| {
+                        if d > s * 0.5 {
+                            d - s
+                        } else if d < -s * 0.5 {
+                            d + s
+                        } else {
+                            d
+                        }
+                    };
+                    let (dx, dy) = (wrap(x - cx), wrap(y - cy));
+                    let d2 = dx * dx + dy * dy;
+                    if d2 < 16.0 * sigma * sigma {
+                        z += sign * height * sigma * (-d2 / (2.0 * sigma * sigma)).exp();
+                    }
+                }
             }
         }
         z
-    })
+    }
+}
+
+/// `builtin:bumps[:SIZE]`: Gaussian bumps at two scales (σ = SIZE/170 and
+/// SIZE/64 texels, at least 1) as an RGB8 normal map (codes `(n + 1)/2`).
+pub fn builtin_bumps(size: u32) -> Result<Texture> {
+    let s = size as f64;
+    let area = s * s / 65536.0;
+    let small = bump_height(
+        size,
+        (s / 170.0).max(1.0),
+        1.0,
+        (2500.0 * area).ceil() as usize,
+        1,
+    );
+    let large = bump_height(
+        size,
+        (s / 64.0).max(1.0),
+        1.0,
+        (400.0 * area).ceil() as usize,
+        2,
+    );
+    let n = normals_of_height(size, |x, y| small(x, y) + large(x, y))?;
+    let Texels::F32(v) = n.texels() else {
+        return Err(Error::InvalidOption("expected f32 normals".into()));
+    };
+    let codes = v
+        .iter()
+        .map(|c| ((c + 1.0) * 0.5 * 255.0).round() as u8)
+        .collect();
+    Texture::from_u8(
+        size,
+        size,
+        Format::new(3, ChannelType::U8, ColorSpace::Linear),
+        codes,
+    )
 }
 
 /// Parallel V-grooves along y, `period` texels apart, walls at
@@ -323,4 +408,141 @@ pub fn height_field(size: u32, roughness: f64, seed: u64) -> Result<Texture> {
         }
         z
     })
+}
+
+/// Which shading [`render`] draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shading {
+    /// Every level-0 normal under the pixel shaded with the base roughness
+    /// and averaged (stratified over the pixel's square, as the box
+    /// reference image samples it).
+    Truth,
+    /// The filtered, renormalised normal with the base roughness.
+    Renormalised,
+    /// The filtered, renormalised normal with the adjusted roughness (or
+    /// Toksvig's exponent for Blinn-Phong).
+    Adjusted,
+}
+
+impl std::str::FromStr for Shading {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "truth" => Ok(Shading::Truth),
+            "renormalised" | "renormalized" => Ok(Shading::Renormalised),
+            "adjusted" => Ok(Shading::Adjusted),
+            _ => Err(Error::parse(
+                "shading",
+                s,
+                "expected truth, renormalised or adjusted",
+            )),
+        }
+    }
+}
+
+/// Shades `scene` in `frame`, normal-mapped with `normals` (three channels,
+/// codes or floats as [`crate::mip::roughness`] reads them), lit from
+/// `light` (tangent space), with base roughness `alpha`: one grey radiance
+/// value per pixel (row-major, `None` where the scene shows nothing). The
+/// plane's view direction follows its camera; other scenes are seen from
+/// straight above. Filtered chains are read with trilinear filtering.
+pub fn render(
+    normals: &Texture,
+    alpha: f32,
+    brdf: Brdf,
+    light: Dir,
+    scene: &crate::scene::Scene,
+    frame: crate::scene::Frame,
+    shading: Shading,
+) -> Result<Vec<Option<f64>>> {
+    use crate::sample::{Query, Sampler, SamplerOptions};
+    use crate::scene::Scene;
+    use crate::scene::reference::{PixelFilter, Reference};
+    if !(alpha > 0.0 && alpha <= 1.0) {
+        return Err(Error::InvalidOption(format!(
+            "the base roughness must be above 0 and at most 1, not {alpha}"
+        )));
+    }
+    let light = unit(light);
+    if !light.iter().all(|c| c.is_finite()) || light[2] <= 0.0 {
+        return Err(Error::InvalidOption(
+            "the light must be a direction above the surface (z > 0)".into(),
+        ));
+    }
+    let o = MipOptions::with_filter(MipFilter::Box);
+    let (spec, base_p) = match brdf {
+        Brdf::CookTorrance => (Specular::Roughness, alpha as f64),
+        Brdf::BlinnPhong => {
+            let s = exponent_of(alpha as f64);
+            (Specular::BlinnPhong(s as f32), s)
+        }
+    };
+    let chain = roughness::build(
+        normals,
+        NormalChannels::Xyz,
+        BaseRoughness::Constant(alpha),
+        spec,
+        &o,
+        &mut |_| {},
+    )?;
+    let tex = (normals.width(), normals.height());
+    let n_chain = MipChain::from_levels(chain.normals.clone(), o)?;
+    let p_chain = MipChain::from_levels(chain.specular, o)?;
+    let level0 = MipChain::from_levels(vec![chain.normals[0].clone()], o)?;
+    let tri = SamplerOptions::trilinear();
+    let ns = Sampler::new(&n_chain, tri)?;
+    let ps = Sampler::new(&p_chain, tri)?;
+    let n0 = Sampler::new(&level0, SamplerOptions::bilinear())?;
+    let view = |x: f64, y: f64| -> Option<Dir> {
+        match scene {
+            Scene::Plane(p) => p.view_dir(frame, x, y),
+            _ => scene.uv(frame, tex, x, y).map(|_| [0.0, 0.0, 1.0]),
+        }
+    };
+    let normal_of = |c: [f32; 4]| -> Dir { unit([c[0] as f64, c[1] as f64, c[2] as f64]) };
+    let grid = Reference::new(PixelFilter::Box);
+    let rows: Vec<Vec<Option<f64>>> = (0..frame.height)
+        .into_par_iter()
+        .map(|py| {
+            (0..frame.width)
+                .map(|px| {
+                    let (cx, cy) = (px as f64 + 0.5, py as f64 + 0.5);
+                    let q = scene.query_at(frame, tex, cx, cy)?;
+                    let v = view(cx, cy)?;
+                    match shading {
+                        Shading::Truth => {
+                            let n = grid.grid(&q, tex);
+                            let (mut sum, mut cnt) = (0.0, 0usize);
+                            for j in 0..n {
+                                for i in 0..n {
+                                    let dx = (i as f64 + 0.5) / n as f64 - 0.5;
+                                    let dy = (j as f64 + 0.5) / n as f64 - 0.5;
+                                    let Some((u, w)) = scene.uv(frame, tex, cx + dx, cy + dy)
+                                    else {
+                                        continue;
+                                    };
+                                    let c = n0.sample(&Query::new(
+                                        u as f32, w as f32, 0.0, 0.0, 0.0, 0.0,
+                                    ));
+                                    sum += radiance(brdf, normal_of(c), light, v, base_p);
+                                    cnt += 1;
+                                }
+                            }
+                            (cnt > 0).then(|| sum / cnt as f64)
+                        }
+                        Shading::Renormalised | Shading::Adjusted => {
+                            let n = normal_of(ns.sample(&q));
+                            let p = if shading == Shading::Adjusted {
+                                ps.sample(&q)[0] as f64
+                            } else {
+                                base_p
+                            };
+                            Some(radiance(brdf, n, light, v, p))
+                        }
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    Ok(rows.into_iter().flatten().collect())
 }

@@ -295,3 +295,42 @@ fn two_channel_maps_rebuild_z() {
         assert!((got - want).abs() < 2e-3, "{got} vs {want}");
     }
 }
+
+#[test]
+fn render_shade_draws_the_three_shadings_and_refuses_bad_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    for s in ["truth", "renormalised", "adjusted"] {
+        let p = dir.path().join(format!("{s}.png"));
+        ok(&parvo(&[
+            "render",
+            "--shade",
+            "cook-torrance",
+            "--texture",
+            "builtin:bumps:128",
+            "--size",
+            "48x32",
+            "--shading",
+            s,
+            "-o",
+            p.to_str().unwrap(),
+        ]));
+        let img = image::open(&p).unwrap();
+        assert_eq!((img.width(), img.height()), (48, 32));
+    }
+    let p = dir.path().join("x.png");
+    for light in ["1,2", "0,0,-1", "a,b,c"] {
+        let o = parvo(&[
+            "render",
+            "--shade",
+            "blinn-phong",
+            "--texture",
+            "builtin:bumps:64",
+            "--light",
+            light,
+            "-o",
+            p.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "--light {light}");
+        assert!(!p.exists());
+    }
+}

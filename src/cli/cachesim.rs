@@ -50,7 +50,7 @@ pub struct CachesimArgs {
     /// Frame size in pixels.
     #[arg(long, default_value = "512x384", value_name = "WxH")]
     size: Frame,
-    /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE].
+    /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
     #[arg(long, default_value = "builtin:checker:1024", value_name = "TEXTURE")]
     texture: String,
     /// Filter: nearest, bilinear, bilinear-nomip, trilinear, aniso, anisoN, ewa, sat, supersample.

@@ -32,7 +32,7 @@ const CHUNK: usize = 1 << 16;
                   channel, in linear light. --filter picks a preset; the other flags override it."
 )]
 pub struct SampleArgs {
-    /// Texture: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], or a file `parvo mip` reads.
+    /// Texture: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE], or a file `parvo mip` reads.
     #[arg(value_name = "TEXTURE")]
     texture: String,
     /// Filter preset: nearest, bilinear, trilinear, aniso, ewa, sat, supersample.

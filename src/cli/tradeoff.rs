@@ -57,7 +57,7 @@ pub struct TradeoffArgs {
     /// Scene: plane, tunnel, zoom, rotate:DEG[:SCALE].
     #[arg(long, default_value = "plane", value_name = "SCENE")]
     scene: Scene,
-    /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE].
+    /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
     #[arg(long, default_value = "builtin:zoneplate:512", value_name = "TEXTURE")]
     texture: String,
     /// Filters by report name.

@@ -42,6 +42,22 @@ impl Default for Plane {
 }
 
 impl Plane {
+    /// The unit direction from the plane's point under screen position
+    /// `(sx, sy)` towards the camera, in the texture's tangent frame (x
+    /// along u, y along v, z the plane's normal); `None` where [`Plane::uv`]
+    /// is.
+    pub fn view_dir(&self, frame: Frame, sx: f64, sy: f64) -> Option<[f64; 3]> {
+        self.uv(frame, sx, sy)?;
+        let (w, h) = (frame.width as f64, frame.height as f64);
+        let t = (self.fov_y * 0.5).tan();
+        let nx = (sx / w * 2.0 - 1.0) * t * (w / h);
+        let ny = (1.0 - sy / h * 2.0) * t;
+        let (sp, cp) = self.pitch.sin_cos();
+        let d = [nx, -sp + ny * cp, cp + ny * sp];
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        Some([-d[0] / l, -d[2] / l, -d[1] / l])
+    }
+
     /// Texture coordinate of screen position `(sx, sy)` in pixels, or
     /// `None` when the ray misses the plane or hits beyond `max_distance`.
     pub fn uv(&self, frame: Frame, sx: f64, sy: f64) -> Option<(f64, f64)> {
