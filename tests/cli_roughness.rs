@@ -334,3 +334,31 @@ fn render_shade_draws_the_three_shadings_and_refuses_bad_lights() {
         assert!(!p.exists());
     }
 }
+
+#[test]
+fn update_skips_only_when_both_files_store_the_fingerprint() {
+    let dir = tempfile::tempdir().unwrap();
+    let (n, r) = (dir.path().join("n.exr"), dir.path().join("r.exr"));
+    let run = |rough: &str| {
+        let o = parvo(&[
+            "mip",
+            "builtin:bumps:64",
+            "--normal-map",
+            "--roughness",
+            rough,
+            "-o",
+            n.to_str().unwrap(),
+            "--roughness-out",
+            r.to_str().unwrap(),
+            "--update",
+        ]);
+        ok(&o);
+        String::from_utf8_lossy(&o.stdout).contains("(up to date)")
+    };
+    assert!(!run("0.3"));
+    assert!(run("0.3"));
+    assert!(!run("0.4"), "a new base roughness rebuilds");
+    std::fs::remove_file(&r).unwrap();
+    assert!(!run("0.4"), "a missing roughness file rebuilds");
+    assert!(r.exists());
+}
