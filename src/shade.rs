@@ -134,6 +134,37 @@ pub fn default_directions() -> Vec<(Dir, Dir)> {
     d
 }
 
+/// The box roughness chain of `normals` for `brdf` at base roughness
+/// `alpha` (Toksvig's exponents for Blinn-Phong), and the base parameter
+/// the BRDF takes (m, or the exponent 2/α² − 2).
+fn base_chain(
+    normals: &Texture,
+    alpha: f32,
+    brdf: Brdf,
+) -> Result<(roughness::RoughnessChain, f64)> {
+    if !(alpha > 0.0 && alpha <= 1.0) {
+        return Err(Error::InvalidOption(format!(
+            "the base roughness must be above 0 and at most 1, not {alpha}"
+        )));
+    }
+    let (spec, base_p) = match brdf {
+        Brdf::CookTorrance => (Specular::Roughness, alpha as f64),
+        Brdf::BlinnPhong => {
+            let s = exponent_of(alpha as f64);
+            (Specular::BlinnPhong(s as f32), s)
+        }
+    };
+    let chain = roughness::build(
+        normals,
+        NormalChannels::Xyz,
+        BaseRoughness::Constant(alpha),
+        spec,
+        &MipOptions::with_filter(MipFilter::Box),
+        &mut |_| {},
+    )?;
+    Ok((chain, base_p))
+}
+
 /// Per level from 1 on, the renormalised and the adjusted chains of
 /// `normals` (a square power-of-two map, box mips) shaded with `brdf` at
 /// base roughness `alpha` against the ground truth, over `dirs`.
@@ -149,28 +180,7 @@ pub fn compare(
             "the shading comparison needs a power-of-two map (footprints are blocks), not {w}x{h}"
         )));
     }
-    if !(alpha > 0.0 && alpha <= 1.0) {
-        return Err(Error::InvalidOption(format!(
-            "the base roughness must be above 0 and at most 1, not {alpha}"
-        )));
-    }
-    let o = MipOptions::with_filter(MipFilter::Box);
-    let spec = match brdf {
-        Brdf::CookTorrance => Specular::Roughness,
-        Brdf::BlinnPhong => Specular::BlinnPhong(exponent_of(alpha as f64) as f32),
-    };
-    let chain = roughness::build(
-        normals,
-        NormalChannels::Xyz,
-        BaseRoughness::Constant(alpha),
-        spec,
-        &o,
-        &mut |_| {},
-    )?;
-    let base_p = match brdf {
-        Brdf::CookTorrance => alpha as f64,
-        Brdf::BlinnPhong => exponent_of(alpha as f64),
-    };
+    let (chain, base_p) = base_chain(normals, alpha, brdf)?;
     let n0: Vec<Dir> = f32s(&chain.normals[0])?
         .chunks_exact(3)
         .map(|n| [n[0] as f64, n[1] as f64, n[2] as f64])
@@ -458,33 +468,14 @@ pub fn render(
     use crate::sample::{Query, Sampler, SamplerOptions};
     use crate::scene::Scene;
     use crate::scene::reference::{PixelFilter, Reference};
-    if !(alpha > 0.0 && alpha <= 1.0) {
-        return Err(Error::InvalidOption(format!(
-            "the base roughness must be above 0 and at most 1, not {alpha}"
-        )));
-    }
     let light = unit(light);
     if !light.iter().all(|c| c.is_finite()) || light[2] <= 0.0 {
         return Err(Error::InvalidOption(
             "the light must be a direction above the surface (z > 0)".into(),
         ));
     }
+    let (chain, base_p) = base_chain(normals, alpha, brdf)?;
     let o = MipOptions::with_filter(MipFilter::Box);
-    let (spec, base_p) = match brdf {
-        Brdf::CookTorrance => (Specular::Roughness, alpha as f64),
-        Brdf::BlinnPhong => {
-            let s = exponent_of(alpha as f64);
-            (Specular::BlinnPhong(s as f32), s)
-        }
-    };
-    let chain = roughness::build(
-        normals,
-        NormalChannels::Xyz,
-        BaseRoughness::Constant(alpha),
-        spec,
-        &o,
-        &mut |_| {},
-    )?;
     let tex = (normals.width(), normals.height());
     let n_chain = MipChain::from_levels(chain.normals.clone(), o)?;
     let p_chain = MipChain::from_levels(chain.specular, o)?;
