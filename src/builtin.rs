@@ -13,6 +13,12 @@
 //! - `bumps`: a normal map (linear RGB8 codes `(n + 1)/2`) of Gaussian
 //!   bumps at two scales ([`crate::shade::builtin_bumps`]), for roughness
 //!   chains and `parvo render --shade`.
+//! - `photo`: a photo-like sRGB RGB8 image: fractal colour noise with
+//!   about the same energy in every octave (the 1/f² power spectrum of
+//!   natural images), under hard-edged translucent discs, so it has
+//!   smooth gradients, fine texture and sharp edges, as photographs do
+//!   (the input of the block-compression table; fixed seed, the same for
+//!   every run).
 
 use crate::error::{Error, Result};
 use crate::texel::{ChannelType, ColorSpace, Format};
@@ -33,6 +39,8 @@ pub enum Builtin {
     ZonePlate,
     /// A normal map of Gaussian bumps.
     Bumps,
+    /// A photo-like colour image.
+    Photo,
 }
 
 /// True if `name` names a built-in texture (starts with `builtin:`).
@@ -56,11 +64,12 @@ pub fn parse(name: &str) -> Result<(Builtin, u32)> {
         "checker" => Builtin::Checker,
         "zoneplate" => Builtin::ZonePlate,
         "bumps" => Builtin::Bumps,
+        "photo" => Builtin::Photo,
         _ => {
             return Err(Error::parse(
                 "built-in texture",
                 name,
-                "known textures: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE]",
+                "known textures: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE], builtin:photo[:SIZE]",
             ));
         }
     };
@@ -93,6 +102,7 @@ pub fn generate(kind: Builtin, size: u32) -> Result<Texture> {
     let n = size as usize;
     match kind {
         Builtin::Bumps => crate::shade::builtin_bumps(size),
+        Builtin::Photo => photo(size),
         Builtin::Checker => {
             let cell = (n / 8).max(1);
             let mut v = vec![0u8; n * n * 4];
@@ -134,6 +144,93 @@ pub fn generate(kind: Builtin, size: u32) -> Result<Texture> {
             )
         }
     }
+}
+
+/// A hash of lattice point `(x, y)` of octave `o`, channel `c`, to
+/// [-1, 1) (SplitMix64's finaliser).
+fn lattice(x: u64, y: u64, o: u64, c: u64) -> f64 {
+    let mut z = x
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(y.wrapping_mul(0xC2B2_AE3D_27D4_EB4F))
+        .wrapping_add(o << 40)
+        .wrapping_add(c << 56);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+}
+
+/// The `photo` built-in (see the module docs).
+fn photo(size: u32) -> Result<Texture> {
+    use rayon::prelude::*;
+    let n = size as usize;
+    // Octaves from a period of half the image down to 2 texels, with
+    // amplitudes falling slowly towards the fine ones (equal amplitudes
+    // would be the 1/f² spectrum; interpolated lattice noise puts a little
+    // less than its share into the band it is made for).
+    let mut periods = Vec::new();
+    let mut p = (n as f64 / 2.0).max(2.0);
+    while p >= 2.0 {
+        periods.push(p);
+        p /= 2.0;
+    }
+    let weight = |p: f64| (p / n as f64).powf(0.15);
+    let norm: f64 = periods.iter().map(|&p| weight(p)).sum::<f64>().max(1e-9);
+    // Discs: centre, radius, colour (fixed pseudo-random).
+    let discs: Vec<([f64; 3], [f64; 3])> = (0..48u64)
+        .map(|i| {
+            let r = |k: u64| 0.5 + 0.5 * lattice(i, k, 99, 7);
+            (
+                [
+                    r(0) * n as f64,
+                    r(1) * n as f64,
+                    (0.02 + 0.12 * r(2)) * n as f64,
+                ],
+                [r(3), r(4), r(5)],
+            )
+        })
+        .collect();
+    let smooth = |t: f64| t * t * (3.0 - 2.0 * t);
+    let mut v = vec![0u8; n * n * 3];
+    v.par_chunks_mut(n * 3).enumerate().for_each(|(y, row)| {
+        for (x, t) in row.chunks_exact_mut(3).enumerate() {
+            let mut ch = [0f64; 3];
+            for (o, &p) in periods.iter().enumerate() {
+                let (fx, fy) = (x as f64 / p, y as f64 / p);
+                let (ix, iy) = (fx.floor(), fy.floor());
+                let (sx, sy) = (smooth(fx - ix), smooth(fy - iy));
+                let (ix, iy) = (ix as u64, iy as u64);
+                let amp = 1.6 * weight(p) / norm;
+                for (c, out) in ch.iter_mut().enumerate() {
+                    let g = |dx: u64, dy: u64| lattice(ix + dx, iy + dy, o as u64, c as u64);
+                    let top = g(0, 0) + (g(1, 0) - g(0, 0)) * sx;
+                    let bot = g(0, 1) + (g(1, 1) - g(0, 1)) * sx;
+                    *out += amp * (top + (bot - top) * sy);
+                }
+            }
+            // Luminance and two weaker chroma axes to RGB.
+            let (l, a, b) = (0.5 + 0.45 * ch[0], 0.25 * ch[1], 0.25 * ch[2]);
+            let mut rgb = [l + a, l - 0.5 * a - 0.3 * b, l + 1.2 * b];
+            let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+            for (d, col) in &discs {
+                let (dx, dy) = (px - d[0], py - d[1]);
+                if dx * dx + dy * dy < d[2] * d[2] {
+                    for c in 0..3 {
+                        rgb[c] = 0.35 * rgb[c] + 0.65 * col[c];
+                    }
+                }
+            }
+            for c in 0..3 {
+                t[c] = (rgb[c].clamp(0.0, 1.0) * 255.0).round() as u8;
+            }
+        }
+    });
+    Texture::from_u8(
+        size,
+        size,
+        Format::new(3, ChannelType::U8, ColorSpace::Srgb),
+        v,
+    )
 }
 
 #[cfg(test)]

@@ -22,8 +22,10 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use crate::compress::{BlockChain, BlockFormat, Quality};
 use crate::error::{Error, Result};
 use crate::io::exr::ExrCompression;
+use crate::io::ktx2::Supercompression;
 use crate::io::{self, FileFormat, Limits, LoadOptions, OutputKind, SaveOptions};
 use crate::mip::roughness::{BaseRoughness, NormalChannels, Specular};
 use crate::mip::{self, MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
@@ -110,6 +112,79 @@ pub struct Settings {
     /// Normal maps: a roughness (or Blinn-Phong exponent) chain from the
     /// spread of the normals (see [`crate::mip::roughness`]).
     pub roughness: Option<RoughnessSettings>,
+    /// Block-compress every level (KTX2 and DDS; needs the `encode`
+    /// feature).
+    pub compress: Option<(BlockFormat, Quality)>,
+    /// KTX2 supercompression of every level.
+    pub supercompression: Option<Supercompression>,
+    /// Resample level 0 first to a block-friendly size.
+    pub resize_to: Option<ResizeTo>,
+    /// Decode the blocks again and measure each level's PSNR (for
+    /// `--stats` and `--json`).
+    pub measure_blocks: bool,
+}
+
+/// Block-friendly level-0 sizes (`--resize-to`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ResizeTo {
+    /// Each side up to the next multiple of 4 (whole blocks at level 0).
+    MultipleOf4,
+    /// Each side to the nearest power of two (ties up): every level of the
+    /// chain stays block-aligned.
+    Pow2,
+}
+
+impl ResizeTo {
+    /// The size `(w, h)` becomes.
+    pub fn apply(self, w: u32, h: u32) -> (u32, u32) {
+        let f = |n: u32| match self {
+            ResizeTo::MultipleOf4 => n.div_ceil(4).saturating_mul(4),
+            ResizeTo::Pow2 => {
+                let up = n.checked_next_power_of_two().unwrap_or(1 << 31);
+                let down = if up == n { n } else { up / 2 };
+                // Nearest in ratio: up when up/n <= n/down.
+                if (up as u64) * (down as u64) <= (n as u64) * (n as u64) || down == 0 {
+                    up
+                } else {
+                    down
+                }
+            }
+        };
+        (f(w), f(h))
+    }
+}
+
+/// Per-level figures of a block-compressed output.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockLevel {
+    /// The level's size.
+    pub width: u32,
+    /// The level's size.
+    pub height: u32,
+    /// Bytes of its blocks.
+    pub bytes: u64,
+    /// Seconds encoding it (levels are encoded in parallel, so these
+    /// overlap).
+    pub encode_s: f64,
+    /// PSNR of the decoded blocks against the uncompressed level (see
+    /// [`crate::compress::psnr`]); `None` unless
+    /// [`Settings::measure_blocks`].
+    pub psnr_db: Option<f64>,
+}
+
+/// What block compression did to one job.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockReport {
+    /// The stored format, e.g. `BC7_SRGB`.
+    pub stored: String,
+    /// The encoder effort.
+    pub quality: Quality,
+    /// Per level, level 0 first.
+    pub levels: Vec<BlockLevel>,
+    /// Bytes the uncompressed levels would take.
+    pub uncompressed_bytes: u64,
+    /// Wall-clock seconds of the whole encode.
+    pub encode_s: f64,
 }
 
 /// Where a normal map's roughness comes from and where it goes.
@@ -157,6 +232,10 @@ impl Default for Settings {
             update: false,
             dry_run: false,
             roughness: None,
+            compress: None,
+            supercompression: None,
+            resize_to: None,
+            measure_blocks: false,
         }
     }
 }
@@ -279,6 +358,65 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
             }
         }
     }
+    if let Some((bf, _)) = s.compress {
+        if !cfg!(feature = "encode") {
+            return bad(format!(
+                "--compress {}: this parvo was built without the `encode` feature (the block encoders)",
+                bf.name().to_ascii_lowercase()
+            ));
+        }
+        if !crate::compress::can_encode(bf) {
+            return bad(format!("parvo does not encode {bf}"));
+        }
+        if let Some(j) = jobs
+            .iter()
+            .find(|j| !matches!(j.kind, OutputKind::Ktx2 | OutputKind::Dds))
+        {
+            return bad(format!(
+                "--compress: {} cannot store block-compressed texels; use .ktx2 or .dds (output {})",
+                j.kind.name(),
+                j.output.display()
+            ));
+        }
+        if let Some(t) = s.out_type {
+            return bad(format!(
+                "--type {t} with --compress: the block format fixes what is stored"
+            ));
+        }
+        if s.roughness.is_some() {
+            return bad(
+                "--compress with --roughness is not supported yet: compress the normal and \
+                 roughness chains in two runs"
+                    .into(),
+            );
+        }
+    }
+    if let Some(sc) = s.supercompression {
+        let (lo, hi) = match sc {
+            Supercompression::Zstd(_) => (1, 22),
+            Supercompression::Zlib(_) => (1, 12),
+        };
+        let (Supercompression::Zstd(l) | Supercompression::Zlib(l)) = sc;
+        if !(lo..=hi).contains(&l) {
+            return bad(format!(
+                "--{} {l}: the level must be from {lo} to {hi}",
+                sc.name()
+            ));
+        }
+        if let Some(j) = jobs.iter().find(|j| j.kind != OutputKind::Ktx2) {
+            return bad(format!(
+                "--{}: supercompression is a KTX2 feature; output {} is {}",
+                sc.name(),
+                j.output.display(),
+                j.kind.name()
+            ));
+        }
+    }
+    if s.resize_to.is_some() && s.normal_map {
+        return bad(
+            "--resize-to with --normal-map is not supported: resize the normal map first".into(),
+        );
+    }
     let rough_out = s
         .roughness
         .as_ref()
@@ -353,6 +491,8 @@ pub struct Outcome {
     pub write_s: f64,
     /// What the loader or the build did that the user would not assume.
     pub notes: Vec<String>,
+    /// Block compression figures, when the output is block-compressed.
+    pub blocks: Option<BlockReport>,
 }
 
 /// Progress of one job.
@@ -366,6 +506,16 @@ pub enum Stage {
     /// Texels made so far.
     Built {
         /// Texels of levels above 0 made so far.
+        texels_done: u64,
+    },
+    /// Block compression starts: this many texels (all levels) to encode.
+    Encoding {
+        /// Texels of all levels.
+        total_texels: u64,
+    },
+    /// Texels encoded so far.
+    Encoded {
+        /// Texels encoded so far.
         texels_done: u64,
     },
     /// The output is being written.
@@ -431,6 +581,9 @@ pub fn fingerprint_text(s: &Settings, opts: &MipOptions, out: &Format, kind: Out
         s.tile.0,
         s.tile.1,
         s.compression,
+    ) + &format!(
+        " compress={:?} supercompression={:?} resize={:?}",
+        s.compress, s.supercompression, s.resize_to
     ) + &match &s.roughness {
         Some(r) => format!(
             " roughness={:?} channels={:?} specular={:?} pack={} rough_out={:?}",
@@ -468,6 +621,23 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     };
     base = base.reinterpret(src)?;
     let read_s = t_read.elapsed().as_secs_f64();
+    if let Some(r) = s.resize_to {
+        let (w, h) = (base.width(), base.height());
+        let (nw, nh) = r.apply(w, h);
+        if (nw, nh) != (w, h) {
+            s.limits.check(nw as u64, nh as u64, 0)?;
+            let opts = MipOptions {
+                filter: s.filter,
+                wrap: s.wrap.or(file_wrap).unwrap_or_default(),
+                ..MipOptions::default()
+            };
+            base = mip::separable::reduce(&base, nw, nh, &opts)?.0;
+            notes.push(format!(
+                "resized {w}x{h} to {nw}x{nh} ({} filter) for --resize-to",
+                s.filter
+            ));
+        }
+    }
 
     let out_format = match &s.roughness {
         // The normal output holds the vectors (and, packed, the roughness
@@ -485,7 +655,19 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
                 Format::new(n, src.channel_type, ColorSpace::Linear).with_alpha(AlphaMode::None);
             output_format(f, job.kind, s)?
         }
-        None => output_format(src, job.kind, s)?,
+        None => match s.compress {
+            // Built in the type the encoder reads (u8, or f16 for BC6H),
+            // then shaped into its input format per level.
+            Some((bf, _)) => {
+                let ty = crate::compress::input_format(bf, src.color_space, None).channel_type;
+                let typed = Settings {
+                    out_type: Some(ty),
+                    ..s.clone()
+                };
+                output_format(src, job.kind, &typed)?
+            }
+            None => output_format(src, job.kind, s)?,
+        },
     };
     let options = MipOptions {
         filter: s.filter,
@@ -520,6 +702,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         build_s: 0.0,
         write_s: 0.0,
         notes: notes.clone(),
+        blocks: None,
     };
     if s.dry_run {
         return Ok(skipped(Status::DryRun));
@@ -580,6 +763,19 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         levels
     };
     let build_s = t_build.elapsed().as_secs_f64();
+    let blocks = match s.compress {
+        Some((bf, quality)) => {
+            notes.extend(compress_notes(bf, src, &level_sizes));
+            Some(encode_chain(
+                &levels,
+                bf,
+                quality,
+                s.measure_blocks,
+                progress,
+            )?)
+        }
+        None => None,
+    };
     progress(Stage::Writing);
 
     let t_write = Instant::now();
@@ -593,13 +789,17 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         tile: s.tile,
         compression: s.compression,
         fingerprint: Some(fingerprint),
+        supercompression: s.supercompression,
         attributes: vec![
             ("parvo:filter".into(), s.filter.to_string()),
             ("parvo:source".into(), src.to_string()),
             ("parvo:rounding".into(), s.rounding.to_string()),
         ],
     };
-    io::save(&levels, s.rounding, &job.output, job.kind, &save)?;
+    match &blocks {
+        Some((chain, _)) => io::save_blocks(chain, &job.output, job.kind, &save)?,
+        None => io::save(&levels, s.rounding, &job.output, job.kind, &save)?,
+    }
     if let (Some(levels), Some(r)) = (rough_levels, &s.roughness)
         && let Some((path, kind)) = &r.output
     {
@@ -644,7 +844,174 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         build_s,
         write_s,
         notes,
+        blocks: blocks.map(|(_, r)| r),
     })
+}
+
+/// What a block format does to this source that the user should hear of:
+/// channels it drops or changes, and levels that are not block-aligned
+/// (WebGL requires every BC level's sides to be 1, 2 or a multiple of 4).
+fn compress_notes(bf: BlockFormat, src: Format, sizes: &[(u32, u32)]) -> Vec<String> {
+    let mut notes = Vec::new();
+    let ch = src.channels;
+    match bf {
+        BlockFormat::Bc4 { .. } if ch > 1 => notes.push(format!(
+            "BC4 stores one channel: the first of the input's {ch} is kept"
+        )),
+        BlockFormat::Bc5 { .. } if ch > 2 => notes.push(format!(
+            "BC5 stores two channels: the first two of the input's {ch} are kept (normal maps: \
+             readers rebuild z as sqrt(1 - x^2 - y^2))"
+        )),
+        BlockFormat::Bc6h { .. } if src.has_alpha() => {
+            notes.push("BC6H stores RGB: the alpha channel is dropped".into())
+        }
+        _ => {}
+    }
+    if matches!(bf, BlockFormat::Bc4 { .. } | BlockFormat::Bc5 { .. })
+        && src.color_space == ColorSpace::Srgb
+    {
+        notes.push(format!(
+            "{bf} has no sRGB variant: the sRGB values are stored decoded to linear"
+        ));
+    }
+    if matches!(bf, BlockFormat::Bc6h { .. }) && !src.channel_type.is_float() {
+        notes.push("BC6H is an HDR format; this input is not float (bc7 stores 8-bit colour in the same size)".into());
+    }
+    let ok = |n: u32| n <= 2 || n.is_multiple_of(4);
+    if let Some((k, &(w, h))) = sizes
+        .iter()
+        .enumerate()
+        .find(|(_, (w, h))| !ok(*w) || !ok(*h))
+    {
+        notes.push(format!(
+            "level {k} is {w}x{h}: block-compressed levels whose sides are not 1, 2 or a multiple of 4 \
+             are refused by WebGL; --resize-to pow2 keeps every level block-aligned"
+        ));
+    }
+    notes
+}
+
+/// Encode every level as `bf` blocks: levels (and bands of large levels)
+/// on all threads, progress reported from the calling thread; with
+/// `measure`, each level decoded again (by `bcdec_rs`, independent of the
+/// encoders) and scored against the uncompressed level.
+fn encode_chain(
+    levels: &[Texture],
+    bf: BlockFormat,
+    quality: Quality,
+    measure: bool,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<(BlockChain, BlockReport)> {
+    #[cfg(not(feature = "encode"))]
+    {
+        let _ = (levels, quality, measure, progress);
+        Err(Error::InvalidOption(format!(
+            "{bf}: this parvo was built without the `encode` feature"
+        )))
+    }
+    #[cfg(feature = "encode")]
+    {
+        use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+        let first = levels
+            .first()
+            .ok_or_else(|| Error::InvalidOption("nothing to encode: no levels".into()))?;
+        let f0 = first.format();
+        let alpha = f0.has_alpha().then_some(f0.alpha);
+        let want = crate::compress::input_format(bf, f0.color_space, alpha);
+        let total: u64 = levels.iter().map(|l| l.texel_count() as u64).sum();
+        progress(Stage::Encoding {
+            total_texels: total,
+        });
+        let done = AtomicU64::new(0);
+        let finished = AtomicBool::new(false);
+        let t0 = Instant::now();
+        let result = std::thread::scope(|scope| {
+            let worker = scope.spawn(|| {
+                let r = levels
+                    .par_iter()
+                    .map(|l| -> Result<(Vec<u8>, BlockLevel)> {
+                        let t = Instant::now();
+                        let input = crate::compress::prepare(l, bf, want)?;
+                        let data = crate::compress::encode::encode(bf, quality, &input)?;
+                        let encode_s = t.elapsed().as_secs_f64();
+                        let psnr_db = if measure {
+                            let dec = crate::compress::decode(
+                                bf,
+                                want.color_space == ColorSpace::Srgb,
+                                want.alpha,
+                                l.width(),
+                                l.height(),
+                                &data,
+                            )?;
+                            let ch = match bf {
+                                BlockFormat::Bc4 { .. } => 1,
+                                BlockFormat::Bc5 { .. } => 2,
+                                BlockFormat::Bc6h { .. } => 3,
+                                _ if want.alpha == AlphaMode::None => 3,
+                                _ => 4,
+                            };
+                            Some(crate::compress::psnr(&input, &dec, ch)?)
+                        } else {
+                            None
+                        };
+                        done.fetch_add(l.texel_count() as u64, Ordering::Relaxed);
+                        Ok((
+                            data,
+                            BlockLevel {
+                                width: l.width(),
+                                height: l.height(),
+                                bytes: 0,
+                                encode_s,
+                                psnr_db,
+                            },
+                        ))
+                    })
+                    .collect::<Result<Vec<_>>>();
+                finished.store(true, Ordering::Release);
+                r
+            });
+            while !finished.load(Ordering::Acquire) {
+                progress(Stage::Encoded {
+                    texels_done: done.load(Ordering::Relaxed),
+                });
+                std::thread::sleep(std::time::Duration::from_millis(50));
+            }
+            worker.join().unwrap_or_else(|_| {
+                Err(Error::InvalidOption(
+                    "internal error: the encoder panicked".into(),
+                ))
+            })
+        })?;
+        progress(Stage::Encoded { texels_done: total });
+        let encode_s = t0.elapsed().as_secs_f64();
+        let mut data = Vec::with_capacity(result.len());
+        let mut report_levels = Vec::with_capacity(result.len());
+        for (d, mut lv) in result {
+            lv.bytes = d.len() as u64;
+            data.push(d);
+            report_levels.push(lv);
+        }
+        let srgb = want.color_space == ColorSpace::Srgb;
+        let chain = BlockChain {
+            format: bf,
+            srgb,
+            alpha: want.alpha,
+            width: first.width(),
+            height: first.height(),
+            levels: data,
+        };
+        let stored = format!("{bf}{}", if srgb { "_SRGB" } else { "" });
+        Ok((
+            chain,
+            BlockReport {
+                stored,
+                quality,
+                levels: report_levels,
+                uncompressed_bytes: levels.iter().map(|l| l.byte_len() as u64).sum(),
+                encode_s,
+            },
+        ))
+    }
 }
 
 /// Runs `jobs`: in parallel when there is more than one, each job's result

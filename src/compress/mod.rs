@@ -9,9 +9,58 @@
 
 use rayon::prelude::*;
 
+#[cfg(feature = "encode")]
+pub mod encode;
+
 use crate::error::{Error, Result};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
+
+/// Encoder effort: what `--quality` selects.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Quality {
+    /// BC7 and BC6H: ISPC's "very fast" profile; BC1/BC3: ISPC (BC1 with
+    /// alpha: texpresso's range fit).
+    Fast,
+    /// BC7 and BC6H: ISPC's "basic" profile; BC1/BC3: ISPC (BC1 with
+    /// alpha: texpresso's cluster fit).
+    #[default]
+    Normal,
+    /// BC7 and BC6H: ISPC's "slow" profile; BC1/BC3: texpresso's iterative
+    /// cluster fit.
+    Slow,
+}
+
+impl Quality {
+    /// `fast`, `normal` or `slow`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quality::Fast => "fast",
+            Quality::Normal => "normal",
+            Quality::Slow => "slow",
+        }
+    }
+}
+
+impl std::fmt::Display for Quality {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Quality {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Ok(match s.to_ascii_lowercase().as_str() {
+            "fast" => Quality::Fast,
+            "normal" => Quality::Normal,
+            "slow" => Quality::Slow,
+            _ => {
+                return Err(Error::parse("quality", s, "expected fast, normal or slow"));
+            }
+        })
+    }
+}
 
 /// A block-compressed format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -110,7 +159,8 @@ impl std::fmt::Display for BlockFormat {
 
 /// Decode one `w × h` level of `format` blocks (row-major blocks, as DDS and
 /// KTX2 store them) to a texture of [`BlockFormat::decoded_format`], with
-/// `alpha` as the alpha convention of the 4-channel formats.
+/// `alpha` as the alpha convention of the 4-channel formats
+/// ([`AlphaMode::None`]: opaque, alpha reads as 1).
 pub fn decode(
     format: BlockFormat,
     srgb: bool,
@@ -130,8 +180,13 @@ pub fn decode(
         });
     }
     let mut tf = format.decoded_format(srgb);
+    // Opaque data (BC1 without alpha, a DDS marked opaque): the alpha the
+    // blocks decode to is not part of the texture (BC1's three-colour mode
+    // decodes black as alpha 0; ISPC's opaque BC7 modes leave some texels
+    // at 254), so it reads as 1.
+    let opaque = tf.channels == 4 && alpha == AlphaMode::None;
     if tf.channels == 4 {
-        tf = tf.with_alpha(alpha);
+        tf = tf.with_alpha(if opaque { AlphaMode::Straight } else { alpha });
     }
     let ch = tf.channels as usize;
     let bw = w.div_ceil(4) as usize;
@@ -201,10 +256,237 @@ pub fn decode(
                     copy_block(&tmp, pitch, o, w * ch, bx * 4 * ch, ch, w - bx * 4, rows);
                 }
             });
+            if opaque {
+                out.iter_mut().skip(3).step_by(4).for_each(|a| *a = u8::MAX);
+            }
             Texels::U8(out)
         }
     };
     Texture::from_texels(w as u32, h as u32, tf, texels)
+}
+
+/// The formats parvo encodes: the unsigned variants of BC1, BC3, BC4,
+/// BC5, BC6H and BC7.
+pub fn can_encode(format: BlockFormat) -> bool {
+    matches!(
+        format,
+        BlockFormat::Bc1
+            | BlockFormat::Bc3
+            | BlockFormat::Bc4 { signed: false }
+            | BlockFormat::Bc5 { signed: false }
+            | BlockFormat::Bc6h { signed: false }
+            | BlockFormat::Bc7
+    )
+}
+
+/// The texel format the encoder of `format` reads, for a source with
+/// colour space `cs` and alpha `alpha`: RGBA u8 for BC1/BC3/BC7 (sRGB
+/// kept, so the `_SRGB` formats are written; a source without alpha gets
+/// an opaque one and [`AlphaMode::None`]), one u8 channel for BC4, two
+/// for BC5 (linear data), RGB f16 for BC6H (linear).
+pub fn input_format(format: BlockFormat, cs: ColorSpace, alpha: Option<AlphaMode>) -> Format {
+    match format {
+        BlockFormat::Bc4 { .. } => {
+            Format::new(1, ChannelType::U8, ColorSpace::Linear).with_alpha(AlphaMode::None)
+        }
+        BlockFormat::Bc5 { .. } => {
+            Format::new(2, ChannelType::U8, ColorSpace::Linear).with_alpha(AlphaMode::None)
+        }
+        BlockFormat::Bc6h { .. } => {
+            Format::new(3, ChannelType::F16, ColorSpace::Linear).with_alpha(AlphaMode::None)
+        }
+        _ => Format::new(4, ChannelType::U8, cs).with_alpha(alpha.unwrap_or(AlphaMode::None)),
+    }
+}
+
+/// A mip chain of block-compressed levels, as the KTX2 and DDS writers
+/// take it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockChain {
+    /// The block format.
+    pub format: BlockFormat,
+    /// The `_SRGB` variant (BC1, BC2, BC3, BC7).
+    pub srgb: bool,
+    /// The alpha of the 4-channel formats: straight, premultiplied, or
+    /// [`AlphaMode::None`] for opaque data (BC1 without alpha).
+    pub alpha: AlphaMode,
+    /// Level 0's size.
+    pub width: u32,
+    /// Level 0's size.
+    pub height: u32,
+    /// The levels' blocks, level 0 first, sizes rounding down.
+    pub levels: Vec<Vec<u8>>,
+}
+
+impl BlockChain {
+    /// Check that every level holds the bytes its size needs.
+    pub fn validate(&self) -> Result<()> {
+        if self.levels.is_empty() {
+            return Err(Error::InvalidOption("nothing to write: no levels".into()));
+        }
+        for (k, l) in self.levels.iter().enumerate() {
+            let (w, h) = crate::mip::level_size(
+                self.width,
+                self.height,
+                k as u32,
+                crate::mip::Rounding::Down,
+            );
+            let need = self.format.level_bytes(w, h);
+            if l.len() as u64 != need {
+                return Err(Error::InvalidOption(format!(
+                    "level {k} ({w}x{h} {}) has {} bytes, needs {need}",
+                    self.format,
+                    l.len()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Decode every level (see [`decode`]).
+    pub fn decode(&self) -> Result<Vec<Texture>> {
+        self.levels
+            .iter()
+            .enumerate()
+            .map(|(k, l)| {
+                let (w, h) = crate::mip::level_size(
+                    self.width,
+                    self.height,
+                    k as u32,
+                    crate::mip::Rounding::Down,
+                );
+                decode(self.format, self.srgb, self.alpha, w, h, l)
+            })
+            .collect()
+    }
+}
+
+/// The first `n` channels of `t` (no alpha among them unless all of a
+/// 2- or 4-channel texture's are kept).
+pub fn first_channels(t: &Texture, n: u8) -> Result<Texture> {
+    let f = t.format();
+    if n == 0 || n > f.channels {
+        return Err(Error::InvalidOption(format!(
+            "cannot take {n} channels of {f}"
+        )));
+    }
+    if n == f.channels {
+        return Ok(t.clone());
+    }
+    fn take<T: Copy>(v: &[T], from: usize, n: usize) -> Vec<T> {
+        v.chunks_exact(from)
+            .flat_map(|p| p[..n].iter().copied())
+            .collect()
+    }
+    let (from, k) = (f.channels as usize, n as usize);
+    let texels = match t.texels() {
+        Texels::U8(v) => Texels::U8(take(v, from, k)),
+        Texels::U16(v) => Texels::U16(take(v, from, k)),
+        Texels::F16(v) => Texels::F16(take(v, from, k)),
+        Texels::F32(v) => Texels::F32(take(v, from, k)),
+    };
+    let format = Format {
+        channels: n,
+        alpha: AlphaMode::None,
+        ..f
+    };
+    Texture::from_texels(t.width(), t.height(), format, texels)
+}
+
+/// `level` in the texel format the encoder of `format` reads
+/// (`encode::input_format`): channels taken or widened (grey to RGB, an
+/// opaque alpha added), then converted (type, and colour space: BC4, BC5
+/// and BC6H store linear values).
+pub fn prepare(level: &Texture, format: BlockFormat, want: Format) -> Result<Texture> {
+    let f = level.format();
+    let shaped = if f.channels > want.channels {
+        first_channels(level, want.channels)?
+    } else if f.channels < want.channels {
+        if f.channels == 1 && want.channels == 2 {
+            return Err(Error::InvalidOption(format!(
+                "{format} stores two channels; the input has one (use bc4)"
+            )));
+        }
+        crate::io::expand_channels(level, want.channels)?
+    } else {
+        level.clone()
+    };
+    let sf = shaped.format();
+    let target = Format {
+        channels: sf.channels,
+        // An alpha channel added by widening is opaque, not alpha data.
+        alpha: if f.has_alpha() && sf.has_alpha() {
+            sf.alpha
+        } else {
+            want.alpha
+        },
+        ..want
+    };
+    let converted =
+        if sf.channel_type == target.channel_type && sf.color_space == target.color_space {
+            shaped
+        } else {
+            shaped.convert(Format {
+                alpha: sf.alpha,
+                ..target
+            })?
+        };
+    converted.reinterpret(target)
+}
+
+/// Peak signal-to-noise ratio, in dB, of `got` against `reference` (same
+/// size, same channel count): over the first `channels` channels of the
+/// stored values, integers scaled to 0..1 with peak 1, floats with the
+/// reference's largest magnitude (at least 1) as the peak. Infinite for
+/// identical levels.
+pub fn psnr(reference: &Texture, got: &Texture, channels: usize) -> Result<f64> {
+    let (rf, gf) = (reference.format(), got.format());
+    if (reference.width(), reference.height()) != (got.width(), got.height())
+        || rf.channels != gf.channels
+        || channels == 0
+        || channels > rf.channels as usize
+    {
+        return Err(Error::InvalidOption(format!(
+            "PSNR of a {}x{} {rf} level against a {}x{} {gf} one",
+            reference.width(),
+            reference.height(),
+            got.width(),
+            got.height()
+        )));
+    }
+    let ch = rf.channels as usize;
+    let values = |t: &Texture| -> Vec<f64> {
+        match t.texels() {
+            Texels::U8(v) => v.iter().map(|&x| x as f64 / 255.0).collect(),
+            Texels::U16(v) => v.iter().map(|&x| x as f64 / 65535.0).collect(),
+            Texels::F16(v) => v.iter().map(|x| x.to_f64()).collect(),
+            Texels::F32(v) => v.iter().map(|&x| x as f64).collect(),
+        }
+    };
+    let (a, b) = (values(reference), values(got));
+    let peak = if rf.channel_type.is_float() {
+        a.iter()
+            .filter(|x| x.is_finite())
+            .fold(1.0f64, |m, x| m.max(x.abs()))
+    } else {
+        1.0
+    };
+    let (mut se, mut n) = (0.0f64, 0u64);
+    for (pa, pb) in a.chunks_exact(ch).zip(b.chunks_exact(ch)) {
+        for c in 0..channels {
+            let d = pa[c] - pb[c];
+            if d.is_finite() {
+                se += d * d;
+            }
+            n += 1;
+        }
+    }
+    let mse = se / n.max(1) as f64;
+    Ok(if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (peak * peak / mse).log10()
+    })
 }
 
 /// Copy the visible part of a decoded 4×4 block (`pitch` values per block

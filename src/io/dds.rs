@@ -65,7 +65,7 @@ use std::io::Write;
 use std::path::Path;
 
 use super::{FileFormat, Limits, Loaded, SourceInfo, atomic};
-use crate::compress::BlockFormat;
+use crate::compress::{BlockChain, BlockFormat};
 use crate::error::{Error, Result};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
@@ -509,6 +509,88 @@ pub fn save(levels: &[Texture], path: &Path) -> Result<()> {
     atomic::write(path, |w| write_to(levels, w))
 }
 
+/// The DXGI format of a block format (`_UNORM_SRGB` when `srgb`).
+pub fn dxgi_block_format(f: BlockFormat, srgb: bool) -> u32 {
+    let s = u32::from(srgb);
+    match f {
+        BlockFormat::Bc1 => 71 + s,
+        BlockFormat::Bc2 => 74 + s,
+        BlockFormat::Bc3 => 77 + s,
+        BlockFormat::Bc4 { signed } => 80 + u32::from(signed),
+        BlockFormat::Bc5 { signed } => 83 + u32::from(signed),
+        BlockFormat::Bc6h { signed } => 95 + u32::from(signed),
+        BlockFormat::Bc7 => 98 + s,
+    }
+}
+
+/// The header parvo writes for a block-compressed chain: the DX10
+/// extension with the block format's DXGI number and alpha mode,
+/// `DDSD_LINEARSIZE` with level 0's byte size (DirectXTex's layout for
+/// compressed textures).
+pub fn header_for_blocks(chain: &BlockChain) -> Result<Header> {
+    chain.validate()?;
+    let n = chain.levels.len() as u32;
+    let full = crate::mip::level_count(chain.width, chain.height, crate::mip::Rounding::Down, None);
+    if n > full {
+        return Err(encode_err(format!(
+            "{n} levels, a {}x{} chain has {full}",
+            chain.width, chain.height
+        )));
+    }
+    let linear = u32::try_from(chain.levels[0].len())
+        .map_err(|_| encode_err("level 0 is too large for a DDS header (4 GiB)"))?;
+    let mode = match chain.alpha {
+        AlphaMode::Premultiplied => alpha_mode::PREMULTIPLIED,
+        AlphaMode::Straight => alpha_mode::STRAIGHT,
+        AlphaMode::None => alpha_mode::OPAQUE,
+    };
+    Ok(Header {
+        flags: ddsd::CAPS
+            | ddsd::HEIGHT
+            | ddsd::WIDTH
+            | ddsd::LINEARSIZE
+            | ddsd::PIXELFORMAT
+            | ddsd::MIPMAPCOUNT,
+        height: chain.height,
+        width: chain.width,
+        pitch_or_linear_size: linear,
+        depth: 0,
+        mip_map_count: n,
+        pixel_format: fourcc_only(DX10),
+        caps: caps::TEXTURE
+            | if n > 1 {
+                caps::COMPLEX | caps::MIPMAP
+            } else {
+                0
+            },
+        caps2: 0,
+        dx10: Some(Dx10 {
+            dxgi_format: dxgi_block_format(chain.format, chain.srgb),
+            resource_dimension: D3D10_RESOURCE_DIMENSION_TEXTURE2D,
+            misc_flag: 0,
+            array_size: 1,
+            misc_flags2: mode,
+        }),
+    })
+}
+
+/// Serialise a block-compressed chain as DDS bytes.
+pub fn write_blocks_to(chain: &BlockChain, out: &mut impl Write) -> Result<()> {
+    let header = header_for_blocks(chain)?;
+    let io = |e: std::io::Error| encode_err(e);
+    out.write_all(&header.to_bytes()).map_err(io)?;
+    for l in &chain.levels {
+        out.write_all(l).map_err(io)?;
+    }
+    Ok(())
+}
+
+/// Write a block-compressed chain as a DDS file atomically.
+pub fn save_blocks(chain: &BlockChain, path: &Path) -> Result<()> {
+    header_for_blocks(chain)?;
+    atomic::write(path, |w| write_blocks_to(chain, w))
+}
+
 /// How the texels of a DDS file are stored, as parsed from its header.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Stored {
@@ -643,10 +725,10 @@ fn stored_of(h: &Header) -> Result<(Stored, String)> {
     if let Some(d) = &h.dx10 {
         let mode = d.misc_flags2 & 7;
         if let Some(&(_, bf, srgb)) = DXGI_BLOCKS.iter().find(|e| e.0 == d.dxgi_format) {
-            let alpha = if mode == alpha_mode::PREMULTIPLIED {
-                AlphaMode::Premultiplied
-            } else {
-                AlphaMode::Straight
+            let alpha = match mode {
+                alpha_mode::PREMULTIPLIED => AlphaMode::Premultiplied,
+                alpha_mode::OPAQUE => AlphaMode::None,
+                _ => AlphaMode::Straight,
             };
             return Ok((
                 Stored::Blocks {

@@ -30,6 +30,7 @@
 use std::path::Path;
 
 use super::{FINGERPRINT_KEY, FileFormat, Limits, Loaded, SaveOptions, SourceInfo, atomic};
+use crate::compress::{BlockChain, BlockFormat};
 use crate::error::{Error, Result};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format};
 use crate::texture::Texture;
@@ -164,19 +165,234 @@ fn lcm(a: u64, b: u64) -> u64 {
     a / gcd(a, b) * b
 }
 
+/// Supercompression of each level's bytes (KTX 2.0 section 3.7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Supercompression {
+    /// Zstandard at this level (1–22): scheme 2.
+    Zstd(i32),
+    /// zlib (RFC 1950) at this level (1–12, libdeflate's scale): scheme 3.
+    Zlib(i32),
+}
+
+impl Supercompression {
+    /// The header's `supercompressionScheme`.
+    pub fn scheme(self) -> u32 {
+        match self {
+            Supercompression::Zstd(_) => 2,
+            Supercompression::Zlib(_) => 3,
+        }
+    }
+
+    /// `zstd` or `zlib`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Supercompression::Zstd(_) => "zstd",
+            Supercompression::Zlib(_) => "zlib",
+        }
+    }
+
+    /// Compress one level's bytes.
+    pub fn compress(self, data: &[u8]) -> Result<Vec<u8>> {
+        match self {
+            Supercompression::Zstd(level) => {
+                zstd::bulk::compress(data, level).map_err(|e| encode_err(format!("zstd: {e}")))
+            }
+            Supercompression::Zlib(level) => {
+                let lvl = libdeflater::CompressionLvl::new(level)
+                    .map_err(|_| encode_err(format!("zlib level {level}: use 1 to 12")))?;
+                let mut c = libdeflater::Compressor::new(lvl);
+                let mut out = vec![0u8; c.zlib_compress_bound(data.len())];
+                let n = c
+                    .zlib_compress(data, &mut out)
+                    .map_err(|e| encode_err(format!("zlib: {e:?}")))?;
+                out.truncate(n);
+                Ok(out)
+            }
+        }
+    }
+}
+
+/// Decompress a level of `scheme` to exactly `len` bytes (the level
+/// index's `uncompressedByteLength`, checked against the limits first).
+fn decompress(scheme: u32, data: &[u8], len: u64, limits: &Limits) -> Result<Vec<u8>> {
+    if len > limits.max_alloc {
+        return Err(Error::Limits(format!(
+            "a level declares {} MiB uncompressed, more than the {} MiB allowed (raise with --max-alloc)",
+            len >> 20,
+            limits.max_alloc >> 20
+        )));
+    }
+    let len = len as usize;
+    let out = match scheme {
+        2 => zstd::bulk::decompress(data, len).map_err(|e| decode_err(format!("zstd: {e}")))?,
+        3 => {
+            let mut out = vec![0u8; len];
+            let n = libdeflater::Decompressor::new()
+                .zlib_decompress(data, &mut out)
+                .map_err(|e| decode_err(format!("zlib: {e:?}")))?;
+            out.truncate(n);
+            out
+        }
+        1 => return Err(decode_err("BasisLZ supercompression is not supported")),
+        s => return Err(decode_err(format!("unknown supercompression scheme {s}"))),
+    };
+    if out.len() != len {
+        return Err(decode_err(format!(
+            "a level decompresses to {} bytes, the level index says {len}",
+            out.len()
+        )));
+    }
+    Ok(out)
+}
+
+/// What the header and DFD say about the texels, besides their bytes.
+struct Desc {
+    vk: u32,
+    type_size: u32,
+    dfd: Vec<u8>,
+    /// Bytes of one texel block (a texel, or a 4×4 block).
+    block_bytes: u64,
+}
+
+/// The `VkFormat` of a block format (the `_SRGB_BLOCK` variant when
+/// `srgb`; BC1 with alpha as `BC1_RGBA`).
+pub fn vk_block_format(f: BlockFormat, srgb: bool, alpha: bool) -> u32 {
+    let s = u32::from(srgb);
+    match f {
+        BlockFormat::Bc1 if alpha => 133 + s,
+        BlockFormat::Bc1 => 131 + s,
+        BlockFormat::Bc2 => 135 + s,
+        BlockFormat::Bc3 => 137 + s,
+        BlockFormat::Bc4 { signed } => 139 + u32::from(signed),
+        BlockFormat::Bc5 { signed } => 141 + u32::from(signed),
+        BlockFormat::Bc6h { signed } => 143 + u32::from(signed),
+        BlockFormat::Bc7 => 145 + s,
+    }
+}
+
+/// The block format of a `VkFormat` (131–146): format, sRGB, BC1 alpha.
+pub fn block_format_of_vk(vk: u32) -> Option<(BlockFormat, bool, bool)> {
+    // The second of each pair: SRGB, or SNORM/SFLOAT.
+    let odd = vk.is_multiple_of(2);
+    Some(match vk {
+        131 | 132 => (BlockFormat::Bc1, odd, false),
+        133 | 134 => (BlockFormat::Bc1, odd, true),
+        135 | 136 => (BlockFormat::Bc2, odd, true),
+        137 | 138 => (BlockFormat::Bc3, odd, true),
+        139 | 140 => (BlockFormat::Bc4 { signed: odd }, false, false),
+        141 | 142 => (BlockFormat::Bc5 { signed: odd }, false, false),
+        143 | 144 => (BlockFormat::Bc6h { signed: odd }, false, false),
+        145 | 146 => (BlockFormat::Bc7, odd, true),
+        _ => return None,
+    })
+}
+
+/// The Data Format Descriptor of a block format (Khronos Data Format
+/// Specification 1.3, section 5.6 and the BC models of section 5.6.3):
+/// colour model `KHR_DF_MODEL_BC1A` … `BC7` (128–134), texel block 4×4,
+/// `bytesPlane0` the block size, one sample per stored part (BC1's
+/// colour, or `ALPHAPRESENT` with alpha; BC2/BC3 alpha at bit 0 and colour
+/// at bit 64; BC5 red and green), sample ranges 0..`u32::MAX` (the values
+/// `libktx` writes), FLOAT (and SIGNED) for BC6H.
+pub fn dfd_block(f: BlockFormat, srgb: bool, premultiplied: bool, alpha: bool) -> Vec<u8> {
+    let (model, samples): (u32, Vec<(u32, u32, u32)>) = match f {
+        // (bit offset, bit length − 1, channel id | qualifiers)
+        BlockFormat::Bc1 => (128, vec![(0, 63, u32::from(alpha))]),
+        BlockFormat::Bc2 => (129, vec![(0, 63, 15), (64, 63, 0)]),
+        BlockFormat::Bc3 => (130, vec![(0, 63, 15), (64, 63, 0)]),
+        BlockFormat::Bc4 { signed } => (131, vec![(0, 63, if signed { 0x40 } else { 0 })]),
+        BlockFormat::Bc5 { signed } => {
+            let q = if signed { 0x40 } else { 0 };
+            (132, vec![(0, 63, q), (64, 63, 1 | q)])
+        }
+        BlockFormat::Bc6h { signed } => (133, vec![(0, 127, if signed { 0xC0 } else { 0x80 })]),
+        BlockFormat::Bc7 => (134, vec![(0, 127, 0)]),
+    };
+    let block_size = 24 + 16 * samples.len() as u32;
+    let mut w: Vec<u32> = vec![
+        4 + block_size,
+        0,
+        2 | (block_size << 16),
+        model | (1 << 8) | ((if srgb { 2 } else { 1 }) << 16) | (u32::from(premultiplied) << 24),
+        3 | (3 << 8), // texel block 4×4×1×1 (dimensions − 1)
+        f.block_bytes() as u32,
+        0,
+    ];
+    for (offset, len1, id) in samples {
+        w.push(offset | (len1 << 16) | (id << 24));
+        w.push(0);
+        let (lower, upper) = match f {
+            BlockFormat::Bc6h { signed: true } => ((-1.0f32).to_bits(), 1.0f32.to_bits()),
+            BlockFormat::Bc6h { signed: false } => (0, 1.0f32.to_bits()),
+            BlockFormat::Bc4 { signed: true } | BlockFormat::Bc5 { signed: true } => {
+                (0x8000_0000, 0x7FFF_FFFF)
+            }
+            _ => (0, u32::MAX),
+        };
+        w.push(lower);
+        w.push(upper);
+    }
+    w.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
 /// Serialise `levels` (level 0 first, sizes rounding down) as KTX2 bytes
 /// written to `out`.
 pub fn write_to(levels: &[Texture], opts: &SaveOptions, out: &mut impl Write) -> Result<()> {
-    let first = &levels[0];
+    let first = levels
+        .first()
+        .ok_or_else(|| encode_err("nothing to write: no levels"))?;
     let f = first.format();
     let vk = vk_format(&f).ok_or_else(|| {
         encode_err(format!(
             "no Vulkan format for {f} (convert it with ktx2::storable)"
         ))
     })?;
-    let n = levels.len() as u64;
-    let texel = f.texel_bytes() as u64;
-    let dfd = dfd(&f);
+    let desc = Desc {
+        vk,
+        type_size: f.channel_type.bytes() as u32,
+        dfd: dfd(&f),
+        block_bytes: f.texel_bytes() as u64,
+    };
+    let payloads: Vec<_> = levels.iter().map(|l| super::le_bytes(l.texels())).collect();
+    write_payloads((first.width(), first.height()), &desc, &payloads, opts, out)
+}
+
+/// Serialise a block-compressed chain as KTX2 bytes written to `out`.
+pub fn write_blocks_to(chain: &BlockChain, opts: &SaveOptions, out: &mut impl Write) -> Result<()> {
+    chain.validate()?;
+    let alpha = chain.alpha != AlphaMode::None;
+    let desc = Desc {
+        vk: vk_block_format(chain.format, chain.srgb, alpha),
+        // Block-compressed formats have typeSize 1 (KTX 2.0 section 3.2).
+        type_size: 1,
+        dfd: dfd_block(
+            chain.format,
+            chain.srgb,
+            chain.alpha == AlphaMode::Premultiplied,
+            alpha,
+        ),
+        block_bytes: chain.format.block_bytes() as u64,
+    };
+    let payloads: Vec<std::borrow::Cow<[u8]>> = chain
+        .levels
+        .iter()
+        .map(|l| std::borrow::Cow::Borrowed(l.as_slice()))
+        .collect();
+    write_payloads((chain.width, chain.height), &desc, &payloads, opts, out)
+}
+
+/// The container around the levels' bytes: header, level index, DFD,
+/// key/value data, then the levels smallest first, supercompressed (on
+/// all threads) when `opts` asks.
+fn write_payloads(
+    (width, height): (u32, u32),
+    desc: &Desc,
+    payloads: &[std::borrow::Cow<[u8]>],
+    opts: &SaveOptions,
+    out: &mut impl Write,
+) -> Result<()> {
+    use rayon::prelude::*;
+    let n = payloads.len() as u64;
     let mut kv = Vec::new();
     let mut entries: Vec<(String, String)> = vec![
         ("KTXorientation".into(), "rd".into()),
@@ -198,60 +414,84 @@ pub fn write_to(levels: &[Texture], opts: &SaveOptions, out: &mut impl Write) ->
     for (k, v) in &entries {
         kv.extend(kv_entry(k, v));
     }
+    // Supercompressed levels: compressed in parallel, written in order.
+    let packed: Option<Vec<Vec<u8>>> = match opts.supercompression {
+        Some(sc) => Some(
+            payloads
+                .par_iter()
+                .map(|p| sc.compress(p))
+                .collect::<Result<Vec<_>>>()?,
+        ),
+        None => None,
+    };
+    let stored: Vec<&[u8]> = match &packed {
+        Some(v) => v.iter().map(|x| x.as_slice()).collect(),
+        None => payloads.iter().map(|p| p.as_ref()).collect(),
+    };
     let level_index_at = 80u64;
     let dfd_at = level_index_at + 24 * n;
-    let kvd_at = dfd_at + dfd.len() as u64;
-    let align = lcm(texel, 4);
+    let kvd_at = dfd_at + desc.dfd.len() as u64;
+    // Section 3.10: levels are aligned to lcm(texel block size, 4), or to
+    // 1 byte when supercompressed.
+    let align = if packed.is_some() {
+        1
+    } else {
+        lcm(desc.block_bytes, 4)
+    };
     let mut at = (kvd_at + kv.len() as u64).next_multiple_of(align);
     let data_start = at;
     // Offsets, smallest level first in the file.
-    let mut offsets = vec![0u64; levels.len()];
-    for k in (0..levels.len()).rev() {
+    let mut offsets = vec![0u64; payloads.len()];
+    for k in (0..payloads.len()).rev() {
         at = at.next_multiple_of(align);
         offsets[k] = at;
-        at += levels[k].byte_len() as u64;
+        at += stored[k].len() as u64;
     }
     let mut head = Vec::with_capacity(data_start as usize);
     head.extend_from_slice(&IDENTIFIER);
     for v in [
-        vk,
-        f.channel_type.bytes() as u32,
-        first.width(),
-        first.height(),
+        desc.vk,
+        desc.type_size,
+        width,
+        height,
         0,
         0,
         1,
         n as u32,
-        0,
+        opts.supercompression.map_or(0, |s| s.scheme()),
     ] {
         head.extend_from_slice(&v.to_le_bytes());
     }
     head.extend_from_slice(&(dfd_at as u32).to_le_bytes());
-    head.extend_from_slice(&(dfd.len() as u32).to_le_bytes());
+    head.extend_from_slice(&(desc.dfd.len() as u32).to_le_bytes());
     head.extend_from_slice(&(kvd_at as u32).to_le_bytes());
     head.extend_from_slice(&(kv.len() as u32).to_le_bytes());
     head.extend_from_slice(&0u64.to_le_bytes());
     head.extend_from_slice(&0u64.to_le_bytes());
-    for (k, l) in levels.iter().enumerate() {
-        let len = l.byte_len() as u64;
-        for v in [offsets[k], len, len] {
+    for k in 0..payloads.len() {
+        for v in [offsets[k], stored[k].len() as u64, payloads[k].len() as u64] {
             head.extend_from_slice(&v.to_le_bytes());
         }
     }
-    head.extend_from_slice(&dfd);
+    head.extend_from_slice(&desc.dfd);
     head.extend_from_slice(&kv);
     head.resize(data_start as usize, 0);
     let io = |e: std::io::Error| encode_err(e.to_string());
     out.write_all(&head).map_err(io)?;
     let mut pos = data_start;
-    for k in (0..levels.len()).rev() {
+    for k in (0..payloads.len()).rev() {
         let pad = (offsets[k] - pos) as usize;
         out.write_all(&vec![0u8; pad]).map_err(io)?;
-        let bytes = super::le_bytes(levels[k].texels());
-        out.write_all(&bytes).map_err(io)?;
-        pos = offsets[k] + bytes.len() as u64;
+        out.write_all(stored[k]).map_err(io)?;
+        pos = offsets[k] + stored[k].len() as u64;
     }
     Ok(())
+}
+
+/// Write a block-compressed chain to a `.ktx2` file atomically.
+pub fn save_blocks(chain: &BlockChain, path: &Path, opts: &SaveOptions) -> Result<()> {
+    chain.validate()?;
+    atomic::write(path, |w| write_blocks_to(chain, opts, w))
 }
 
 /// Write `levels` to a `.ktx2` file atomically.
@@ -299,21 +539,25 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     let bytes = read_bytes(path, limits)?;
     let r = ::ktx2::Reader::new(bytes.as_slice()).map_err(decode_err)?;
     let h = r.header();
-    if h.supercompression_scheme.is_some() {
-        return Err(decode_err("supercompressed files are not supported"));
-    }
     if h.pixel_depth > 1 || h.layer_count > 1 || h.face_count != 1 {
         return Err(decode_err(
             "only 2-D textures are supported (no arrays, cube maps or volumes)",
         ));
     }
+    let scheme = u32::from_le_bytes(bytes[44..48].try_into().map_err(decode_err)?);
     let vk = h.format.map(|f| f.value()).unwrap_or(0);
-    let mut format = format_of_vk(vk).ok_or_else(|| {
-        decode_err(format!(
-            "vkFormat {vk} is not an uncompressed format parvo reads"
-        ))
-    })?;
-    if r.is_alpha_premultiplied() == Some(true) {
+    let block = block_format_of_vk(vk);
+    let mut format = match block {
+        Some((bf, srgb, _)) => bf.decoded_format(srgb),
+        None => format_of_vk(vk).ok_or_else(|| {
+            decode_err(format!(
+                "vkFormat {vk} is not a format parvo reads (uncompressed R/RG/RGB/RGBA 8/16-bit and \
+                 float, BC1-BC7)"
+            ))
+        })?,
+    };
+    let premultiplied = r.is_alpha_premultiplied() == Some(true);
+    if premultiplied && format.has_alpha() {
         format = format.with_alpha(AlphaMode::Premultiplied);
     }
     let (w, hgt) = (h.pixel_width, h.pixel_height.max(1));
@@ -321,15 +565,45 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     let mut levels = Vec::new();
     for (k, level) in r.levels().enumerate() {
         let (lw, lh) = crate::mip::level_size(w, hgt, k as u32, crate::mip::Rounding::Down);
-        let need = lw as usize * lh as usize * format.texel_bytes();
-        if level.data.len() != need {
-            return Err(decode_err(format!(
-                "level {k} has {} bytes, {lw}x{lh} needs {need}",
-                level.data.len()
-            )));
-        }
-        let texels = super::texels_from_le(format.channel_type, level.data);
-        levels.push(Texture::from_texels(lw, lh, format, texels)?);
+        let unpacked;
+        let data: &[u8] = if scheme != 0 {
+            unpacked = decompress(scheme, level.data, level.uncompressed_byte_length, limits)?;
+            &unpacked
+        } else {
+            level.data
+        };
+        let level_tex = match block {
+            Some((bf, srgb, has_alpha)) => {
+                let need = bf.level_bytes(lw, lh);
+                if data.len() as u64 != need {
+                    return Err(decode_err(format!(
+                        "level {k} has {} bytes, a {lw}x{lh} {bf} level needs {need}",
+                        data.len()
+                    )));
+                }
+                let alpha = if !has_alpha {
+                    // BC1_RGB: alpha is 1 whatever the blocks say.
+                    AlphaMode::None
+                } else if premultiplied {
+                    AlphaMode::Premultiplied
+                } else {
+                    AlphaMode::Straight
+                };
+                crate::compress::decode(bf, srgb, alpha, lw, lh, data)?
+            }
+            None => {
+                let need = lw as usize * lh as usize * format.texel_bytes();
+                if data.len() != need {
+                    return Err(decode_err(format!(
+                        "level {k} has {} bytes, {lw}x{lh} needs {need}",
+                        data.len()
+                    )));
+                }
+                let texels = super::texels_from_le(format.channel_type, data);
+                Texture::from_texels(lw, lh, format, texels)?
+            }
+        };
+        levels.push(level_tex);
     }
     if levels.is_empty() {
         return Err(decode_err("no levels"));
@@ -348,6 +622,22 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         })
         .collect();
     attributes.push(("vkFormat".into(), format!("{:?}", h.format)));
+    if let Some((bf, srgb, _)) = block {
+        attributes.push((
+            "stored".into(),
+            format!("{bf}{}", if srgb { "_SRGB" } else { "" }),
+        ));
+    }
+    if scheme != 0 {
+        attributes.push((
+            "supercompression".into(),
+            match scheme {
+                2 => "zstd".into(),
+                3 => "zlib".into(),
+                s => s.to_string(),
+            },
+        ));
+    }
     attributes.sort();
     let mut notes = Vec::new();
     let wrap = super::recorded_wrap(
@@ -357,6 +647,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
             .map(|(_, v)| v.as_str()),
         &mut notes,
     );
+    let format = levels.first().map_or(format, |l| l.format());
     let mut info = SourceInfo::new(FileFormat::Ktx2, &format);
     info.notes = notes;
     info.channel_names = match format.channels {

@@ -666,6 +666,8 @@ pub struct SaveOptions {
     /// Channel names for EXR output (one per channel, e.g. the source's
     /// `N.X,N.Y,N.Z`); `None` writes `R,G,B,A`, `Y,A` or `Y`.
     pub channel_names: Option<Vec<String>>,
+    /// KTX2 supercompression of every level (zstd or zlib).
+    pub supercompression: Option<ktx2::Supercompression>,
 }
 
 impl Default for SaveOptions {
@@ -677,6 +679,7 @@ impl Default for SaveOptions {
             fingerprint: None,
             attributes: Vec::new(),
             channel_names: None,
+            supercompression: None,
         }
     }
 }
@@ -718,6 +721,24 @@ pub fn save(
         OutputKind::Ktx2 => ktx2::save(levels, path, options),
         OutputKind::Dds => dds::save(levels, path),
         OutputKind::PngLevels => png_levels::save(levels, path),
+    }
+}
+
+/// Write a block-compressed chain to `path` atomically: KTX2 (with
+/// `options`' key/value data and supercompression) or DDS (DX10 header).
+pub fn save_blocks(
+    chain: &crate::compress::BlockChain,
+    path: &Path,
+    kind: OutputKind,
+    options: &SaveOptions,
+) -> Result<()> {
+    match kind {
+        OutputKind::Ktx2 => ktx2::save_blocks(chain, path, options),
+        OutputKind::Dds => dds::save_blocks(chain, path),
+        _ => Err(Error::InvalidOption(format!(
+            "{} cannot store block-compressed texels: use .ktx2 or .dds",
+            kind.name()
+        ))),
     }
 }
 

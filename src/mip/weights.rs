@@ -72,9 +72,13 @@ pub fn exact(filter: MipFilter, src: u32, dst: u32, wrap: WrapMode) -> Vec<Vec<(
                     }
                 }
             } else {
-                let s = src as f64 / dst as f64;
+                // The kernel is stretched by the reduction factor, never
+                // narrowed: an enlarged axis (`--resize-to`) keeps the
+                // kernel's own width in source texels.
+                let ratio = src as f64 / dst as f64;
+                let s = ratio.max(1.0);
                 let k = filter.kernel();
-                let c = (x as f64 + 0.5) * s;
+                let c = (x as f64 + 0.5) * ratio;
                 let r = k.radius() * s;
                 for i in (c - r - 0.5).floor() as i64..=(c + r + 0.5).ceil() as i64 {
                     let w = k.evaluate((i as f64 + 0.5 - c) / s);
