@@ -34,6 +34,8 @@ pub struct TextureStore {
     own_levels: Option<Vec<Texture>>,
     options: MipOptions,
     level0: OnceLock<MipChain>,
+    /// The block format the file stored its levels in, if any.
+    blocks: Option<crate::compress::BlockFormat>,
     chain: OnceLock<Result<MipChain, String>>,
     sat: OnceLock<Result<Arc<SatSampler>, String>>,
 }
@@ -47,6 +49,7 @@ impl TextureStore {
             own_levels: None,
             options,
             level0: OnceLock::new(),
+            blocks: None,
             chain: OnceLock::new(),
             sat: OnceLock::new(),
         }
@@ -70,13 +73,21 @@ impl TextureStore {
     pub fn load(name: &str, limits: &crate::io::Limits) -> Result<Self> {
         let loaded = crate::io::load(name, limits)?;
         let wrap = loaded.info.wrap.unwrap_or_default();
-        Ok(Self::from_levels(
+        let mut s = Self::from_levels(
             loaded.levels,
             MipOptions {
                 wrap,
                 ..Default::default()
             },
-        ))
+        );
+        s.blocks = loaded.info.blocks;
+        Ok(s)
+    }
+
+    /// The block format of a block-compressed file the store was loaded
+    /// from (its levels are decoded; memory traffic counts whole blocks).
+    pub fn stored_blocks(&self) -> Option<crate::compress::BlockFormat> {
+        self.blocks
     }
 
     /// The options the chain is built with (its wrap mode is the

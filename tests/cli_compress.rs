@@ -219,3 +219,39 @@ fn usage_errors_are_refused_before_any_work() {
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
+
+/// `parvo cachesim` on a block-compressed file counts whole blocks: the
+/// same accesses as the uncompressed file, a fraction of its bytes.
+#[test]
+fn cachesim_counts_blocks_of_compressed_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = dir.path().join("c.ktx2");
+    let bc7 = dir.path().join("c7.dds");
+    ok(&parvo(&["mip", "builtin:checker:256", "-o", p(&plain)]));
+    ok(&parvo(&[
+        "mip",
+        "builtin:checker:256",
+        "-o",
+        p(&bc7),
+        "--compress",
+        "bc7",
+        "--quality",
+        "fast",
+    ]));
+    let bytes = |f: &Path| -> (u64, String) {
+        let o = ok(&parvo(&["cachesim", "--texture", p(f), "--size", "128x96"]));
+        let line = o
+            .lines()
+            .find(|l| l.starts_with("bytes from memory"))
+            .unwrap()
+            .to_string();
+        let n = line.split_whitespace().nth(3).unwrap().parse().unwrap();
+        (n, o)
+    };
+    let ((bu, _), (bc, text)) = (bytes(&plain), bytes(&bc7));
+    assert!(
+        text.contains("BC7 blocks, 16 bytes per 4x4 block"),
+        "{text}"
+    );
+    assert!(bc * 2 < bu, "BC7 {bc} bytes, RGBA8 {bu}");
+}

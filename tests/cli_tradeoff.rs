@@ -169,6 +169,49 @@ fn only_what_the_filters_read_is_built() {
     }
 }
 
+/// `--compress bc7` adds a row per filter for the compressed chain: the
+/// same filter's texels per pixel, less traffic (a 16-byte block holds 16
+/// texels where RGBA8 holds 4 per 16 bytes), accuracy close to the
+/// uncompressed row's.
+#[cfg(feature = "encode")]
+#[test]
+fn compressed_rows_count_whole_blocks() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c");
+    ok(&parvo(&[
+        "tradeoff",
+        "--size",
+        "64x48",
+        "--runs",
+        "1",
+        "--filters",
+        "trilinear,aniso8",
+        "--compress",
+        "bc7",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let r = report(&out);
+    let rows = r["filters"].as_array().unwrap();
+    let row = |n: &str| rows.iter().find(|x| x["name"] == n).unwrap().clone();
+    for f in ["trilinear", "aniso8"] {
+        let (u, c) = (row(f), row(&format!("{f}+bc7")));
+        assert_eq!(c["stored"], "BC7");
+        assert_eq!(c["texels_per_pixel"], u["texels_per_pixel"], "{f}");
+        let (bu, bc) = (
+            u["bytes_per_pixel"].as_f64().unwrap(),
+            c["bytes_per_pixel"].as_f64().unwrap(),
+        );
+        assert!(bc < bu, "{f}: {bc} bytes/px compressed, {bu} uncompressed");
+        let (pu, pc) = (
+            u["psnr_db"].as_f64().unwrap(),
+            c["psnr_db"].as_f64().unwrap(),
+        );
+        assert!((pu - pc).abs() < 3.0, "{f}: {pu} dB vs {pc} dB");
+        assert!(out.join(format!("{f}+bc7.png")).is_file());
+    }
+}
+
 #[test]
 fn bad_arguments_are_usage_errors() {
     let dir = tempfile::tempdir().unwrap();

@@ -12,6 +12,11 @@
 //! - `blocked:TWxTH:SWxSH`: super-tiles of SW×SH texels made of TW×TH
 //!   tiles (Hakura & Gupta's "6D" blocking), each level row-major.
 //!
+//! Block-compressed chains ([`ChainLayout::blocks`]) lay out 4×4 blocks
+//! instead of texels: the layout's unit is the block (`tiled:4x4` is then 4×4
+//! blocks), a texel's address is its block's, and an access reads the
+//! whole block (8 or 16 bytes), as a GPU's texture unit fetches it.
+//!
 //! [`ChainLayout::address`] is a pure function; every layout maps the
 //! texels of a chain to distinct, non-overlapping byte ranges inside
 //! [`ChainLayout::total_bytes`] (tested for odd and non-square sizes). A
@@ -213,7 +218,10 @@ impl Layout {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ChainLayout {
     layout: Layout,
+    /// Bytes of one access: a texel, or a block.
     texel: u64,
+    /// log2 of the block side in texels: 0 for texels, 2 for 4×4 blocks.
+    block_shift: u32,
     /// Per level: width, height, base address.
     levels: Vec<(u32, u32, u64)>,
     /// Summed-area table: entries per row, entry bytes, base address.
@@ -234,10 +242,29 @@ impl ChainLayout {
         ChainLayout {
             layout,
             texel: texel_bytes,
+            block_shift: 0,
             levels,
             sat: None,
             total: at,
         }
+    }
+
+    /// The layout of a block-compressed chain with levels of the given
+    /// sizes (in texels): 4×4 blocks of `block_bytes` each are the unit
+    /// (see the module docs).
+    pub fn blocks(layout: Layout, sizes: &[(u32, u32)], block_bytes: u64) -> Self {
+        let in_blocks: Vec<(u32, u32)> = sizes
+            .iter()
+            .map(|&(w, h)| (w.div_ceil(4), h.div_ceil(4)))
+            .collect();
+        let mut c = ChainLayout::new(layout, &in_blocks, block_bytes);
+        c.block_shift = 2;
+        c
+    }
+
+    /// The side of the unit in texels: 1, or 4 for block-compressed chains.
+    pub fn block_side(&self) -> u32 {
+        1 << self.block_shift
     }
 
     /// The layout of `chain`'s levels in its stored format.
@@ -268,6 +295,29 @@ impl ChainLayout {
         }
     }
 
+    /// [`ChainLayout::for_sampler`] for a chain stored as `blocks` (see
+    /// [`ChainLayout::blocks`]), or as texels when `None`.
+    pub fn for_sampler_stored(
+        chain: &crate::MipChain,
+        sampler: &crate::Sampler,
+        layout: Layout,
+        blocks: Option<crate::compress::BlockFormat>,
+    ) -> Self {
+        let Some(bf) = blocks else {
+            return Self::for_sampler(chain, sampler, layout);
+        };
+        let sizes: Vec<(u32, u32)> = chain
+            .levels()
+            .iter()
+            .map(|l| (l.width(), l.height()))
+            .collect();
+        let c = Self::blocks(layout, &sizes, bf.block_bytes() as u64);
+        match sampler.sat() {
+            Some(s) => c.with_sat(sizes[0].0, sizes[0].1, s.table().entry_bytes()),
+            None => c,
+        }
+    }
+
     /// Texel bytes for `channels` channels of `bytes_per_channel` bytes:
     /// three channels are padded to four.
     pub fn texel_bytes(channels: u8, bytes_per_channel: usize) -> u64 {
@@ -290,7 +340,8 @@ impl ChainLayout {
         self.layout
     }
 
-    /// Bytes per texel.
+    /// Bytes of one texel access (the whole block for block-compressed
+    /// chains).
     pub fn texel(&self) -> u64 {
         self.texel
     }
@@ -319,6 +370,7 @@ impl ChainLayout {
     #[inline]
     pub fn address(&self, level: u32, x: u32, y: u32) -> u64 {
         let (w, _, base) = self.levels[level as usize];
+        let (x, y) = (x >> self.block_shift, y >> self.block_shift);
         base + self.layout.offset(w, x, y) * self.texel
     }
 
@@ -384,5 +436,38 @@ mod tests {
             sh: 4,
         };
         assert_eq!(b.offset(8, 5, 6), 57);
+    }
+
+    /// Block-compressed chains: the texels of one 4×4 block share its
+    /// address, distinct blocks get distinct `block_bytes` ranges, and
+    /// levels hold whole blocks (a 5×3 level is 2×1 blocks).
+    #[test]
+    fn block_layouts_address_whole_blocks() {
+        let sizes = [(10, 6), (5, 3), (2, 1), (1, 1)];
+        for layout in [
+            Layout::Linear,
+            Layout::Tiled { tw: 2, th: 2 },
+            Layout::Morton,
+        ] {
+            let c = ChainLayout::blocks(layout, &sizes, 16);
+            assert_eq!(c.texel(), 16);
+            assert_eq!(c.block_side(), 4);
+            let mut seen = std::collections::HashMap::new();
+            for (k, &(w, h)) in sizes.iter().enumerate() {
+                for y in 0..h {
+                    for x in 0..w {
+                        let a = c.address(k as u32, x, y);
+                        assert_eq!(a % 16, 0);
+                        assert!(a + 16 <= c.total_bytes());
+                        let block = (k, x / 4, y / 4);
+                        if let Some(prev) = seen.insert(a, block) {
+                            assert_eq!(prev, block, "{layout}: two blocks at {a}");
+                        }
+                    }
+                }
+            }
+            // 3x2 + 2x1 + 1 + 1 blocks.
+            assert_eq!(seen.len(), 6 + 2 + 1 + 1, "{layout}");
+        }
     }
 }

@@ -170,9 +170,9 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         Ok(o) => o,
         Err(e) => return usage(format!("{e:#}")),
     };
-    let chain = load(&args.texture)?;
+    let (chain, blocks) = load(&args.texture)?;
     let sampler = Sampler::new(&chain, options)?;
-    let layout = ChainLayout::for_sampler(&chain, &sampler, args.layout);
+    let layout = ChainLayout::for_sampler_stored(&chain, &sampler, args.layout, blocks);
     let setup = SceneSetup {
         sampler: &sampler,
         layout: &layout,
@@ -230,12 +230,22 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
     }
     let report = Report {
         what: format!(
-            "scene {} {}, texture {} ({}, {} bytes per texel, {} levels), filter {}, layout {}, order {}",
+            "scene {} {}, texture {} ({}, {} levels), filter {}, layout {}, order {}",
             args.scene,
             args.size,
             args.texture,
-            chain.levels()[0].format(),
-            layout.texel(),
+            match blocks {
+                Some(b) => format!(
+                    "{b} blocks, {} bytes per 4x4 block (a texel read fetches its block; the \
+                     layout counts blocks)",
+                    layout.texel()
+                ),
+                None => format!(
+                    "{}, {} bytes per texel",
+                    chain.levels()[0].format(),
+                    layout.texel()
+                ),
+            },
             chain.len(),
             sampler.options().name(),
             args.layout,
@@ -266,8 +276,10 @@ fn sampler_options(args: &CachesimArgs, name: &str) -> Result<SamplerOptions> {
     Ok(o)
 }
 
-fn load(texture: &str) -> Result<MipChain> {
-    parvo::io::load_chain(texture, &parvo::io::Limits::default())
+/// The texture's chain (its own levels, or built), and the block format a
+/// block-compressed file stores (its traffic counts whole blocks).
+fn load(texture: &str) -> Result<(MipChain, Option<parvo::compress::BlockFormat>)> {
+    parvo::io::load_chain_stored(texture, &parvo::io::Limits::default())
         .with_context(|| format!("cannot read texture `{texture}`"))
 }
 
@@ -532,7 +544,7 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
         }
     }
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let chain = load(&args.texture)?;
+    let (chain, blocks) = load(&args.texture)?;
     let total = (filters.len() * args.layouts.len() * caches.len()) as u64;
     let bar = progress_bar(args);
     if let Some(b) = &bar {
@@ -543,7 +555,7 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
     for (name, options) in &filters {
         let sampler = Sampler::new(&chain, *options)?;
         for &layout in &args.layouts {
-            let cl = ChainLayout::for_sampler(&chain, &sampler, layout);
+            let cl = ChainLayout::for_sampler_stored(&chain, &sampler, layout, blocks);
             let setup = SceneSetup {
                 sampler: &sampler,
                 layout: &cl,

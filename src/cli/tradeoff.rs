@@ -21,6 +21,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use parvo::cache::layout::{ChainLayout, Layout};
 use parvo::cache::run::SceneSetup;
 use parvo::cache::sim::CacheConfig;
+use parvo::compress::{BlockFormat, Quality};
 use parvo::sample::{Query, Sampler, SamplerOptions, TexelSink};
 use parvo::scene::metrics::{flicker, scores};
 use parvo::scene::reference::{PixelFilter, Reference};
@@ -82,11 +83,34 @@ pub struct TradeoffArgs {
     /// Reference samples per level-0 texel along each axis (default 1).
     #[arg(long, value_name = "N")]
     spp: Option<f64>,
+    /// Also measure every filter on the chain block-compressed to this format (bc1, bc3, bc4, bc5, bc7, bc6h).
+    #[arg(
+        long,
+        value_enum,
+        value_name = "FORMAT",
+        long_help = "Add a row per filter for the chain block-compressed to FORMAT (every level \
+        encoded, then decoded again, as a GPU samples it): named FILTER+bc7 and so on. Their accuracy \
+        is the compressed texture's against the same reference; their traffic counts whole 4x4 blocks \
+        (a texel read fetches its block: 8 or 16 bytes), laid out with the same layout in units of \
+        blocks; their speed is the decoded chain's on the CPU (a GPU decodes blocks in the texture unit)."
+    )]
+    compress: Option<super::mip::CompressArg>,
+    /// Encoder effort for --compress.
+    #[arg(
+        long,
+        value_enum,
+        default_value = "normal",
+        value_name = "Q",
+        requires = "compress"
+    )]
+    quality: super::mip::QualityArg,
 }
 
 /// One filter's row of the report.
 struct Row {
     name: String,
+    /// What the chain stores: its texel format, or the block format.
+    stored: String,
     ns_per_pixel: f64,
     texels_per_pixel: f64,
     bytes_per_pixel: f64,
@@ -124,6 +148,113 @@ impl TexelSink for TileSink {
         let k = level as usize;
         let w = self.sizes[k].0.div_ceil(64);
         self.tiles[k][((y / 64) * w + x / 64) as usize] = true;
+    }
+}
+
+/// What every row's measurement shares.
+struct RowEnv<'a> {
+    scene: Scene,
+    frame: Frame,
+    out: &'a Path,
+    ref0: &'a parvo::scene::metrics::Pixels,
+    ref1: &'a parvo::scene::metrics::Pixels,
+    q0: &'a [Option<Query>],
+    q1: &'a [Option<Query>],
+    dense: &'a [Query],
+    cache: &'a CacheConfig,
+    order: RasterOrder,
+}
+
+impl RowEnv<'_> {
+    /// Render, score, simulate and write the images of one filter.
+    fn row(
+        &self,
+        name: String,
+        stored: String,
+        sampler: &Sampler,
+        cl: &ChainLayout,
+        ns: f64,
+    ) -> Result<Row> {
+        let img0 = render(sampler, self.q0);
+        let img1 = render(sampler, self.q1);
+        let sc = scores(self.ref0, &img0);
+        let fl = flicker((&img0, &img1), (self.ref0, self.ref1));
+        let setup = SceneSetup {
+            sampler,
+            layout: cl,
+            scene: self.scene,
+            frame: self.frame,
+            order: self.order,
+        };
+        let run = setup.simulate(self.cache, None, &mut |_| Ok(()), &|_, _| {})?;
+        let mut tiles = TileSink::new(sampler);
+        let mut out = vec![[0f32; 4]; self.dense.len()];
+        sampler.sample_slice_traced(self.dense, &mut out, &mut tiles)?;
+        let working_set = tiles
+            .tiles
+            .iter()
+            .enumerate()
+            .map(|(k, t)| {
+                let touched = t.iter().filter(|&&b| b).count();
+                serde_json::json!({
+                    "level": k,
+                    "touched": touched > 0,
+                    "tiles_touched": touched,
+                    "tiles": t.len(),
+                    "fraction": touched as f64 / t.len().max(1) as f64,
+                })
+            })
+            .collect();
+        let scale = error_scale(&img0, self.ref0);
+        let frame = self.frame;
+        write_image(&self.out.join(format!("{name}.png")), frame, &img0)?;
+        write_error_map(
+            &self.out.join(format!("{name}-error.png")),
+            frame,
+            &img0,
+            self.ref0,
+            scale,
+        )?;
+        if name == "trilinear" || name == "aniso16" {
+            let tint = show_levels(sampler, self.q0, &img0);
+            write_rgb(&self.out.join(format!("{name}-levels.png")), frame, &tint)?;
+        }
+        Ok(Row {
+            name,
+            stored,
+            ns_per_pixel: ns,
+            texels_per_pixel: run.reads as f64 / run.pixels.max(1) as f64,
+            bytes_per_pixel: run.stats.bytes_from_memory() as f64 / run.pixels.max(1) as f64,
+            psnr_db: sc.psnr_db,
+            rmse: sc.rmse,
+            max_error: sc.max_error,
+            flicker: fl,
+            error_scale: scale,
+            working_set,
+        })
+    }
+}
+
+/// The store's full chain block-compressed and decoded again, and the
+/// stored format's name.
+fn compressed_chain(
+    store: &TextureStore,
+    bf: BlockFormat,
+    quality: Quality,
+) -> Result<(Vec<parvo::texture::Texture>, String)> {
+    #[cfg(feature = "encode")]
+    {
+        let levels = store.chain()?.levels();
+        let (decoded, _) = parvo::compress::round_trip(levels, bf, quality)?;
+        let srgb = decoded[0].format().color_space == parvo::texel::ColorSpace::Srgb;
+        Ok((decoded, format!("{bf}{}", if srgb { "_SRGB" } else { "" })))
+    }
+    #[cfg(not(feature = "encode"))]
+    {
+        let _ = (store, quality);
+        Err(anyhow!(
+            "{bf}: this parvo was built without the `encode` feature"
+        ))
     }
 }
 
@@ -225,6 +356,9 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
     let layout: Layout = LAYOUT.parse()?;
     let order: RasterOrder = ORDER.parse()?;
 
+    if args.compress.is_some() && !cfg!(feature = "encode") {
+        return usage("--compress: this parvo was built without the `encode` feature".into());
+    }
     let mut samplers = Vec::new();
     for (_, options) in &mut filters {
         options.wrap = wrap;
@@ -233,66 +367,54 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
     step("timing");
     let timings = ns_per_query(&samplers.iter().collect::<Vec<_>>(), &dense, args.runs);
     let mut rows = Vec::new();
-    for (((name, options), sampler), ns) in filters.into_iter().zip(samplers).zip(timings) {
-        step(&name);
-        let img0 = render(&sampler, &q0);
-        let img1 = render(&sampler, &q1);
-        let sc = scores(&ref0, &img0);
-        let fl = flicker((&img0, &img1), (&ref0, &ref1));
-        let cl = ChainLayout::for_sampler(store.chain_for(&options)?, &sampler, layout);
-        let setup = SceneSetup {
-            sampler: &sampler,
-            layout: &cl,
-            scene: args.scene,
-            frame,
-            order,
-        };
-        let run = setup.simulate(&cache, None, &mut |_| Ok(()), &|_, _| {})?;
-        let mut tiles = TileSink::new(&sampler);
-        let mut out = vec![[0f32; 4]; dense.len()];
-        sampler.sample_slice_traced(&dense, &mut out, &mut tiles)?;
-        let working_set = tiles
-            .tiles
-            .iter()
-            .enumerate()
-            .map(|(k, t)| {
-                let touched = t.iter().filter(|&&b| b).count();
-                serde_json::json!({
-                    "level": k,
-                    "touched": touched > 0,
-                    "tiles_touched": touched,
-                    "tiles": t.len(),
-                    "fraction": touched as f64 / t.len().max(1) as f64,
-                })
-            })
-            .collect();
-        let scale = error_scale(&img0, &ref0);
-        write_image(&args.out.join(format!("{name}.png")), frame, &img0)?;
-        write_error_map(
-            &args.out.join(format!("{name}-error.png")),
-            frame,
-            &img0,
-            &ref0,
-            scale,
-        )?;
-        if name == "trilinear" || name == "aniso16" {
-            let tint = show_levels(&sampler, &q0, &img0);
-            write_rgb(&args.out.join(format!("{name}-levels.png")), frame, &tint)?;
-        }
-        rows.push(Row {
-            name,
-            ns_per_pixel: ns,
-            texels_per_pixel: run.reads as f64 / run.pixels.max(1) as f64,
-            bytes_per_pixel: run.stats.bytes_from_memory() as f64 / run.pixels.max(1) as f64,
-            psnr_db: sc.psnr_db,
-            rmse: sc.rmse,
-            max_error: sc.max_error,
-            flicker: fl,
-            error_scale: scale,
-            working_set,
-        });
+    let env = RowEnv {
+        scene: args.scene,
+        frame,
+        out: &args.out,
+        ref0: &ref0,
+        ref1: &ref1,
+        q0: &q0,
+        q1: &q1,
+        dense: &dense,
+        cache: &cache,
+        order,
+    };
+    let stored = match store.stored_blocks() {
+        Some(b) => b.name().to_string(),
+        None => base.format().to_string(),
+    };
+    for ((name, options), (sampler, ns)) in filters.iter().zip(samplers.iter().zip(&timings)) {
+        step(name);
+        let chain = store.chain_for(options)?;
+        let cl = ChainLayout::for_sampler_stored(chain, sampler, layout, store.stored_blocks());
+        rows.push(env.row(name.clone(), stored.clone(), sampler, &cl, *ns)?);
         if let Some(b) = &bar {
             b.inc(1);
+        }
+    }
+    if let Some(c) = args.compress {
+        let bf: BlockFormat = c.into();
+        let quality = match args.quality {
+            super::mip::QualityArg::Fast => Quality::Fast,
+            super::mip::QualityArg::Normal => Quality::Normal,
+            super::mip::QualityArg::Slow => Quality::Slow,
+        };
+        step(&format!("{} encode", bf));
+        let (decoded, stored) = compressed_chain(&store, bf, quality)?;
+        let cstore = TextureStore::from_levels(decoded, *store.options());
+        let tag = bf.name().to_ascii_lowercase().replace("_uf16", "");
+        let mut csamplers = Vec::new();
+        for (_, options) in &filters {
+            csamplers.push(cstore.sampler(*options)?);
+        }
+        let ctimings = ns_per_query(&csamplers.iter().collect::<Vec<_>>(), &dense, args.runs);
+        for ((name, options), (sampler, ns)) in filters.iter().zip(csamplers.iter().zip(&ctimings))
+        {
+            let name = format!("{name}+{tag}");
+            step(&name);
+            let chain = cstore.chain_for(options)?;
+            let cl = ChainLayout::for_sampler_stored(chain, sampler, layout, Some(bf));
+            rows.push(env.row(name, stored.clone(), sampler, &cl, *ns)?);
         }
     }
     if let Some(b) = &bar {
@@ -323,6 +445,7 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
         },
         "filters": rows.iter().map(|r| serde_json::json!({
             "name": r.name,
+            "stored": r.stored,
             "ns_per_pixel": r.ns_per_pixel,
             "texels_per_pixel": r.texels_per_pixel,
             "bytes_per_pixel": r.bytes_per_pixel,

@@ -361,6 +361,40 @@ impl BlockChain {
     }
 }
 
+/// Encode every level of a chain as `format` and decode it again (by the
+/// independent decoder): the texels a GPU would filter from the
+/// compressed chain, and the bytes of its blocks.
+#[cfg(feature = "encode")]
+pub fn round_trip(
+    levels: &[Texture],
+    format: BlockFormat,
+    quality: Quality,
+) -> Result<(Vec<Texture>, u64)> {
+    let first = levels
+        .first()
+        .ok_or_else(|| Error::InvalidOption("nothing to encode: no levels".into()))?;
+    let f = first.format();
+    let want = input_format(format, f.color_space, f.has_alpha().then_some(f.alpha));
+    let out: Vec<(Texture, u64)> = levels
+        .par_iter()
+        .map(|l| {
+            let input = prepare(l, format, want)?;
+            let blocks = encode::encode(format, quality, &input)?;
+            let d = decode(
+                format,
+                want.color_space == ColorSpace::Srgb,
+                want.alpha,
+                l.width(),
+                l.height(),
+                &blocks,
+            )?;
+            Ok((d, blocks.len() as u64))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let bytes = out.iter().map(|x| x.1).sum();
+    Ok((out.into_iter().map(|x| x.0).collect(), bytes))
+}
+
 /// The first `n` channels of `t` (no alpha among them unless all of a
 /// 2- or 4-channel texture's are kept).
 pub fn first_channels(t: &Texture, n: u8) -> Result<Texture> {

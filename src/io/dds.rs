@@ -1118,6 +1118,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     if let Stored::Blocks { format: bf, .. } = stored {
         info.attributes
             .push(("dds:compression".into(), bf.name().to_string()));
+        info.blocks = Some(bf);
     }
     if let Some(d) = &header.dx10 {
         let mode = match d.misc_flags2 & 7 {

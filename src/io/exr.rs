@@ -914,6 +914,7 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         channel_names: order.iter().map(|&i| list[i].name.to_string()).collect(),
         attributes,
         notes,
+        blocks: None,
     };
     Ok(Loaded { levels, info })
 }

@@ -656,6 +656,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         _ => super::layout_names(&format),
     };
     info.own_mips = levels.len() > 1;
+    info.blocks = block.map(|b| b.0);
     info.wrap = wrap;
     info.attributes = attributes;
     Ok(Loaded { levels, info })

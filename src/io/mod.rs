@@ -104,6 +104,9 @@ pub struct SourceInfo {
     /// orientation applied), one sentence each; the CLI prints them on
     /// stderr.
     pub notes: Vec<String>,
+    /// The block format the file stores its levels in (decoded on load),
+    /// if it is block-compressed.
+    pub blocks: Option<crate::compress::BlockFormat>,
 }
 
 impl SourceInfo {
@@ -117,6 +120,7 @@ impl SourceInfo {
             channel_names: layout_names(texels),
             attributes: Vec::new(),
             notes: Vec::new(),
+            blocks: None,
         }
     }
 
@@ -296,17 +300,28 @@ pub fn load_with(spec: &str, limits: &Limits, options: &LoadOptions) -> Result<L
 /// (EXR, KTX2, DDS), otherwise a box-filtered chain built from level 0
 /// (wrap modes from the file when it names them, else repeat).
 pub fn load_chain(spec: &str, limits: &Limits) -> Result<MipChain> {
+    load_chain_stored(spec, limits).map(|c| c.0)
+}
+
+/// [`load_chain`], and the block format a block-compressed file stores its
+/// levels in (they are decoded), if any.
+pub fn load_chain_stored(
+    spec: &str,
+    limits: &Limits,
+) -> Result<(MipChain, Option<crate::compress::BlockFormat>)> {
     let loaded = load(spec, limits)?;
+    let blocks = loaded.info.blocks;
     let options = MipOptions {
         rounding: loaded.info.rounding,
         wrap: loaded.info.wrap.unwrap_or_default(),
         ..MipOptions::default()
     };
-    if loaded.levels.len() > 1 {
-        MipChain::from_levels(loaded.levels, options)
+    let chain = if loaded.levels.len() > 1 {
+        MipChain::from_levels(loaded.levels, options)?
     } else {
-        mip::build(loaded.into_base(), &options)
-    }
+        mip::build(loaded.into_base(), &options)?
+    };
+    Ok((chain, blocks))
 }
 
 /// The colour transfer a PNG's chunks declare, as OpenImageIO reads them:
