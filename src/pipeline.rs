@@ -934,26 +934,6 @@ fn encode_chain(
                         let input = crate::compress::prepare(l, bf, want)?;
                         let data = crate::compress::encode::encode(bf, quality, &input)?;
                         let encode_s = t.elapsed().as_secs_f64();
-                        let psnr_db = if measure {
-                            let dec = crate::compress::decode(
-                                bf,
-                                want.color_space == ColorSpace::Srgb,
-                                want.alpha,
-                                l.width(),
-                                l.height(),
-                                &data,
-                            )?;
-                            let ch = match bf {
-                                BlockFormat::Bc4 { .. } => 1,
-                                BlockFormat::Bc5 { .. } => 2,
-                                BlockFormat::Bc6h { .. } => 3,
-                                _ if want.alpha == AlphaMode::None => 3,
-                                _ => 4,
-                            };
-                            Some(crate::compress::psnr(&input, &dec, ch)?)
-                        } else {
-                            None
-                        };
                         done.fetch_add(l.texel_count() as u64, Ordering::Relaxed);
                         Ok((
                             data,
@@ -962,7 +942,7 @@ fn encode_chain(
                                 height: l.height(),
                                 bytes: 0,
                                 encode_s,
-                                psnr_db,
+                                psnr_db: None,
                             },
                         ))
                     })
@@ -990,6 +970,35 @@ fn encode_chain(
             lv.bytes = d.len() as u64;
             data.push(d);
             report_levels.push(lv);
+        }
+        if measure {
+            // After the encode, so the encode times do not include it.
+            let ch = match bf {
+                BlockFormat::Bc4 { .. } => 1,
+                BlockFormat::Bc5 { .. } => 2,
+                BlockFormat::Bc6h { .. } => 3,
+                _ if want.alpha == AlphaMode::None => 3,
+                _ => 4,
+            };
+            let scores = levels
+                .par_iter()
+                .zip(&data)
+                .map(|(l, d)| {
+                    let input = crate::compress::prepare(l, bf, want)?;
+                    let dec = crate::compress::decode(
+                        bf,
+                        want.color_space == ColorSpace::Srgb,
+                        want.alpha,
+                        l.width(),
+                        l.height(),
+                        d,
+                    )?;
+                    crate::compress::psnr(&input, &dec, ch)
+                })
+                .collect::<Result<Vec<_>>>()?;
+            for (lv, p) in report_levels.iter_mut().zip(scores) {
+                lv.psnr_db = Some(p);
+            }
         }
         let srgb = want.color_space == ColorSpace::Srgb;
         let chain = BlockChain {
