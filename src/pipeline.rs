@@ -1170,6 +1170,11 @@ fn build_colour(
     same: bool,
     progress: &mut dyn FnMut(mip::Progress),
 ) -> Result<(Vec<Texture>, Option<String>)> {
+    if !same
+        && let Some(r) = build_streamed(&base, options, src, out_format, association, progress)?
+    {
+        return Ok((r, None));
+    }
     let work_base = if same {
         base
     } else {
@@ -1209,6 +1214,138 @@ fn build_colour(
         )
     });
     Ok((levels, note))
+}
+
+/// Rows of level 0 per band of [`build_streamed`]'s level-0 conversion.
+const BAND_ROWS: usize = 64;
+
+/// The colour chain of an integer source (u8, u16) converted to another
+/// type, box filter, even level 0, without a full-resolution f32 copy of
+/// level 0: level 0 goes to the output type band by band (decode, alpha
+/// association, encode: elementwise, so the same bits as converting the
+/// decoded level whole), level 1 is filtered from level-0 rows decoded as
+/// they are read ([`mip::fast::box_f32_rows`]: the same kernel as the
+/// whole-level box), and the rest of the chain is built from level 1 in
+/// f32 as before. `None` when the shortcut does not apply (other filters,
+/// odd sizes, alpha coverage, float sources): the caller builds whole.
+///
+/// Memory at the peak (level 1 being filtered): the source, level 0 in the
+/// output type and level 1 in f32 — for RGBA8 → half EXR 4 + 8 + 4 bytes
+/// per level-0 texel, where decoding level 0 whole held 4 + 16 + 8.
+fn build_streamed(
+    base: &Texture,
+    options: &MipOptions,
+    src: Format,
+    out_format: Format,
+    association: Option<AlphaMode>,
+    progress: &mut dyn FnMut(mip::Progress),
+) -> Result<Option<Vec<Texture>>> {
+    let (w, h) = (base.width() as usize, base.height() as usize);
+    let sizes = mip::level_sizes(
+        base.width(),
+        base.height(),
+        options.rounding,
+        options.max_levels,
+    );
+    let applies = options.filter == MipFilter::Box
+        && options.fast_paths
+        && options.alpha_coverage.is_none()
+        && !options.normal_map
+        && matches!(src.channel_type, ChannelType::U8 | ChannelType::U16)
+        && w.is_multiple_of(2)
+        && h.is_multiple_of(2)
+        && sizes.len() >= 2
+        && sizes[1] == (base.width() / 2, base.height() / 2);
+    if !applies {
+        return Ok(None);
+    }
+    let ch = src.channels as usize;
+    let f32fmt =
+        Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
+    let stored = base.format();
+    let decode_rows = |y0: usize, n: usize, out: &mut [f32]| match base.texels() {
+        Texels::U8(v) => crate::texel::decode_u8(&stored, &v[y0 * w * ch..(y0 + n) * w * ch], out),
+        Texels::U16(v) => {
+            crate::texel::decode_u16(&stored, &v[y0 * w * ch..(y0 + n) * w * ch], out)
+        }
+        _ => unreachable!("integer sources only"),
+    };
+    let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
+    let mut p = mip::Progress {
+        levels_done: 1,
+        levels_total: sizes.len() as u32,
+        texels_done: 0,
+        texels_total,
+    };
+    progress(p);
+    // Level 1 from rows decoded on the thread that filters them.
+    let straight = f32fmt
+        .alpha_channel()
+        .filter(|_| f32fmt.alpha == AlphaMode::Straight);
+    let (l1, _) = mip::fast::box_f32_rows(
+        &|j, out: &mut [f32]| decode_rows(j, 1, out),
+        w,
+        h,
+        f32fmt,
+        straight,
+    );
+    let level1 = Texture::from_f32(sizes[1].0, sizes[1].1, f32fmt, l1)?;
+    // Level 0 in the output type, band by band.
+    let narrow = Format {
+        channels: src.channels,
+        ..out_format
+    };
+    let mut out0 = Texels::zeroed(
+        out_format.channel_type,
+        w * h * out_format.channels as usize,
+    );
+    let out_ch = out_format.channels as usize;
+    let mut band = vec![0f32; BAND_ROWS * w * ch];
+    for y0 in (0..h).step_by(BAND_ROWS) {
+        let n = BAND_ROWS.min(h - y0);
+        let lin = &mut band[..n * w * ch];
+        decode_rows(y0, n, lin);
+        let t = Texture::from_f32(w as u32, n as u32, f32fmt, lin.to_vec())?;
+        let t = convert_level(associate(t, association)?, out_format)?;
+        let at = y0 * w * out_ch..(y0 + n) * w * out_ch;
+        match (&mut out0, t.texels()) {
+            (Texels::U8(o), Texels::U8(v)) => o[at].copy_from_slice(v),
+            (Texels::U16(o), Texels::U16(v)) => o[at].copy_from_slice(v),
+            (Texels::F16(o), Texels::F16(v)) => o[at].copy_from_slice(v),
+            (Texels::F32(o), Texels::F32(v)) => o[at].copy_from_slice(v),
+            _ => {
+                return Err(Error::InvalidOption(format!(
+                    "internal: level 0 band converted to {}, expected {narrow}",
+                    t.format()
+                )));
+            }
+        }
+    }
+    let level0 = Texture::from_texels(base.width(), base.height(), out_format, out0)?;
+    p.levels_done = 2;
+    p.texels_done = sizes[1].0 as u64 * sizes[1].1 as u64;
+    progress(p);
+    // The rest from level 1, in f32, as the whole-level build does.
+    let rest_options = MipOptions {
+        max_levels: Some(sizes.len() as u32 - 1),
+        ..*options
+    };
+    let done1 = p.texels_done;
+    let chain = mip::build_with_progress(level1, &rest_options, &mut |q| {
+        progress(mip::Progress {
+            levels_done: q.levels_done + 1,
+            levels_total: sizes.len() as u32,
+            texels_done: done1 + q.texels_done,
+            texels_total,
+        })
+    })?;
+    let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len());
+    for l in chain.into_levels().into_iter().rev() {
+        levels.push(convert_level(associate(l, association)?, out_format)?);
+    }
+    levels.push(level0);
+    levels.reverse();
+    Ok(Some(levels))
 }
 
 /// Texels with a channel outside [0, 1] (or NaN).

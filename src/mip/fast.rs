@@ -492,34 +492,88 @@ pub fn box_f32(src: &[f32], sw: usize, fmt: Format, straight: Option<usize>) -> 
                 let y = task * per + i;
                 let r0 = &src[2 * y * sw * ch..][..sw * ch];
                 let r1 = &src[(2 * y + 1) * sw * ch..][..sw * ch];
-                match (ch, straight) {
-                    (4, _) => {
-                        let (alpha_differs, bad) = row_f32x4(r0, r1, d);
-                        // Alpha weighting changes nothing when every alpha
-                        // of both rows is the same (the opaque case).
-                        if let Some(a) = straight
-                            && alpha_differs
-                        {
-                            row_f32_straight(r0, r1, d, 4, a);
-                        }
-                        if bad && !all_finite(d) {
-                            finite.store(false, Ordering::Relaxed);
-                        }
-                    }
-                    (3, _) => row_f32::<3>(r0, r1, d),
-                    (2, None) => row_f32::<2>(r0, r1, d),
-                    (1, _) => row_f32::<1>(r0, r1, d),
-                    (2, Some(a)) => {
-                        row_f32::<2>(r0, r1, d);
-                        if !f32_alpha_constant::<2>(r0, r1, a) {
-                            row_f32_straight(r0, r1, d, 2, a);
-                        }
-                    }
-                    _ => unreachable!("channel count is validated to 1..=4"),
+                if !box_row_f32(r0, r1, d, ch, straight) {
+                    finite.store(false, Ordering::Relaxed);
                 }
             }
         });
-    (dst, finite.into_inner())
+    (dst, finite.load(Ordering::Relaxed))
+}
+
+/// [`box_f32`] of a level that is never held whole in f32: `row(j, out)`
+/// writes source row `j` (linear f32, `sw · channels` values) into `out`,
+/// each row asked for once, by the thread that filters it. The same row
+/// kernel runs on the same values, so the result is bit for bit that of
+/// [`box_f32`] on the whole decoded level (`tests/mip_streamed.rs`).
+pub fn box_f32_rows(
+    row: &(dyn Fn(usize, &mut [f32]) + Sync),
+    sw: usize,
+    sh: usize,
+    fmt: Format,
+    straight: Option<usize>,
+) -> (Vec<f32>, bool) {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let ch = fmt.channels as usize;
+    let (w, h) = (sw / 2, sh / 2);
+    let len = w * ch;
+    let mut dst: Vec<f32> = crate::mem::zeroed(len * h);
+    let per = rows_per_task(len * 4);
+    let finite = AtomicBool::new(ch == 4);
+    dst.par_chunks_mut(len * per).enumerate().for_each_init(
+        || (vec![0f32; sw * ch], vec![0f32; sw * ch]),
+        |(r0, r1), (task, out)| {
+            for (i, d) in out.chunks_exact_mut(len).enumerate() {
+                let y = task * per + i;
+                row(2 * y, r0);
+                row(2 * y + 1, r1);
+                if !box_row_f32(r0, r1, d, ch, straight) {
+                    finite.store(false, Ordering::Relaxed);
+                }
+            }
+        },
+    );
+    (dst, finite.load(Ordering::Relaxed))
+}
+
+/// One destination row of [`box_f32`] from source rows `r0` and `r1`;
+/// false when the RGBA kernel saw a non-finite output (the other kernels
+/// do not track it and return true only for RGBA's flag's sake: the
+/// caller starts from `ch == 4`).
+#[inline]
+fn box_row_f32(r0: &[f32], r1: &[f32], d: &mut [f32], ch: usize, straight: Option<usize>) -> bool {
+    match (ch, straight) {
+        (4, _) => {
+            let (alpha_differs, bad) = row_f32x4(r0, r1, d);
+            // Alpha weighting changes nothing when every alpha of both
+            // rows is the same (the opaque case).
+            if let Some(a) = straight
+                && alpha_differs
+            {
+                row_f32_straight(r0, r1, d, 4, a);
+            }
+            !(bad && !all_finite(d))
+        }
+        (3, _) => {
+            row_f32::<3>(r0, r1, d);
+            true
+        }
+        (2, None) => {
+            row_f32::<2>(r0, r1, d);
+            true
+        }
+        (1, _) => {
+            row_f32::<1>(r0, r1, d);
+            true
+        }
+        (2, Some(a)) => {
+            row_f32::<2>(r0, r1, d);
+            if !f32_alpha_constant::<2>(r0, r1, a) {
+                row_f32_straight(r0, r1, d, 2, a);
+            }
+            true
+        }
+        _ => unreachable!("channel count is validated to 1..=4"),
+    }
 }
 
 fn all_finite(v: &[f32]) -> bool {

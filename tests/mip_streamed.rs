@@ -1,0 +1,158 @@
+//! The pipeline's streamed chain (level 0 converted band by band, level 1
+//! filtered from level-0 rows decoded as they are read, never a whole f32
+//! copy of level 0) equals, bit for bit, the whole-image chain: level 0
+//! decoded whole to linear f32, `mip::build` in f32, each level's alpha
+//! associated and converted to the output type. Sizes where bands meet
+//! (more than one 64-row band, a last partial band), straight alpha that
+//! varies (alpha-weighted boxes), sRGB and linear, u8 and u16 sources, and
+//! the outputs that convert (half EXR, premultiplied; f32 KTX2; u16 PNG).
+
+use parvo::io::{self, Limits};
+use parvo::mip::{self, MipOptions};
+use parvo::pipeline::{self, Job, Settings};
+use parvo::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
+use parvo::texture::Texture;
+
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        self.0 >> 33
+    }
+}
+
+/// RGBA with alpha varying in blocks (so some 2×2 boxes weight by alpha,
+/// others are opaque), of `ty` (u8 or u16), sRGB.
+fn source(w: u32, h: u32, ty: ChannelType, seed: u64) -> Texture {
+    let mut r = Rng(seed);
+    let n = (w * h * 4) as usize;
+    let f = Format::new(4, ty, ColorSpace::Srgb);
+    let alpha_of = |i: usize, r: &mut Rng| -> u64 {
+        let (x, y) = ((i / 4) as u32 % w, (i / 4) as u32 / w);
+        if (x / 6 + y / 5) % 3 == 0 {
+            r.next()
+        } else {
+            u64::MAX
+        }
+    };
+    match ty {
+        ChannelType::U8 => {
+            let v: Vec<u8> = (0..n)
+                .map(|i| {
+                    if i % 4 == 3 {
+                        alpha_of(i, &mut r) as u8
+                    } else {
+                        r.next() as u8
+                    }
+                })
+                .collect();
+            Texture::from_u8(w, h, f, v).unwrap()
+        }
+        _ => {
+            let v: Vec<u16> = (0..n)
+                .map(|i| {
+                    if i % 4 == 3 {
+                        alpha_of(i, &mut r) as u16
+                    } else {
+                        r.next() as u16
+                    }
+                })
+                .collect();
+            Texture::from_u16(w, h, f, v).unwrap()
+        }
+    }
+}
+
+/// The whole-image chain, as the pipeline built it before streaming.
+fn whole(base: &Texture, out: Format, premultiply: bool) -> Vec<Texture> {
+    let f32fmt =
+        Format::new(4, ChannelType::F32, ColorSpace::Linear).with_alpha(base.format().alpha);
+    let lin = base.convert(f32fmt).unwrap();
+    let chain = mip::build(lin, &MipOptions::default()).unwrap();
+    chain
+        .into_levels()
+        .into_iter()
+        .map(|mut l| {
+            if premultiply {
+                let Texels::F32(v) = l.texels_mut() else {
+                    unreachable!()
+                };
+                for px in v.chunks_exact_mut(4) {
+                    let a = px[3];
+                    px[..3].iter_mut().for_each(|c| *c *= a);
+                }
+                let f = l.format().with_alpha(AlphaMode::Premultiplied);
+                l = l.reinterpret(f).unwrap();
+            }
+            let target = Format {
+                alpha: l.format().alpha,
+                ..out
+            };
+            l.convert(target).unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn streamed_chains_equal_whole_image_chains_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = 0;
+    for (w, h) in [(130, 258), (64, 64), (2, 200), (1024, 6)] {
+        for ty in [ChannelType::U8, ChannelType::U16] {
+            case += 1;
+            let src = source(w, h, ty, case);
+            let png = dir.path().join(format!("src{case}_{{level}}.png"));
+            io::png_levels::save(std::slice::from_ref(&src), &png).unwrap();
+            let input = png.to_str().unwrap().replace("{level}", "0");
+            // (output, output type, premultiplied)
+            let outs = [
+                ("exr", ChannelType::F16, true),
+                ("ktx2", ChannelType::F32, false),
+                ("png", ChannelType::U16, false),
+            ];
+            for (ext, ty_out, premul) in outs {
+                if ty_out == ty {
+                    continue; // same type: no conversion, not streamed
+                }
+                let out = if ext == "png" {
+                    dir.path().join(format!("o{case}_{{level}}.png"))
+                } else {
+                    dir.path().join(format!("o{case}.{ext}"))
+                };
+                let settings = Settings {
+                    out_type: Some(ty_out),
+                    ..Settings::default()
+                };
+                let job = Job::new(&input, &out).unwrap();
+                pipeline::process(&job, &settings, &mut |_| {}).unwrap();
+                let got: Vec<Texture> = if ext == "png" {
+                    (0..)
+                        .map(|k| out.to_str().unwrap().replace("{level}", &k.to_string()))
+                        .take_while(|p| std::path::Path::new(p).exists())
+                        .map(|p| io::load(&p, &Limits::default()).unwrap().into_base())
+                        .collect()
+                } else {
+                    io::load(out.to_str().unwrap(), &Limits::default())
+                        .unwrap()
+                        .levels
+                };
+                let cs = if ty_out.is_float() {
+                    ColorSpace::Linear
+                } else {
+                    ColorSpace::Srgb
+                };
+                let want = whole(&src, Format::new(4, ty_out, cs), premul);
+                assert_eq!(got.len(), want.len(), "{w}x{h} {ty} -> {ext}");
+                for (k, (g, e)) in got.iter().zip(&want).enumerate() {
+                    assert!(
+                        g.texels() == e.texels(),
+                        "{w}x{h} {ty} -> {ext}: level {k} differs"
+                    );
+                }
+            }
+        }
+    }
+}
