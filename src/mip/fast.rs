@@ -551,7 +551,7 @@ fn box_row_f32(r0: &[f32], r1: &[f32], d: &mut [f32], ch: usize, straight: Optio
             {
                 row_f32_straight(r0, r1, d, 4, a);
             }
-            !(bad && !all_finite(d))
+            !bad || all_finite(d)
         }
         (3, _) => {
             row_f32::<3>(r0, r1, d);
