@@ -1170,11 +1170,14 @@ fn build_colour(
     same: bool,
     progress: &mut dyn FnMut(mip::Progress),
 ) -> Result<(Vec<Texture>, Option<String>)> {
-    if !same
-        && let Some(r) = build_streamed(&base, options, src, out_format, association, progress)?
-    {
-        return Ok((r, None));
-    }
+    let base = if same {
+        base
+    } else {
+        match build_streamed(base, options, src, out_format, association, progress)? {
+            Ok(levels) => return Ok((levels, None)),
+            Err(base) => base,
+        }
+    };
     let work_base = if same {
         base
     } else {
@@ -1216,30 +1219,36 @@ fn build_colour(
     Ok((levels, note))
 }
 
-/// Rows of level 0 per band of [`build_streamed`]'s level-0 conversion.
-const BAND_ROWS: usize = 64;
+/// Most levels [`build_streamed`] makes band by band (bands of up to
+/// 2^4 = 16 level-0 rows: a band of 16384-wide RGBA f32 is 4 MiB).
+const STREAM_LEVELS: u32 = 4;
 
 /// The colour chain of an integer source (u8, u16) converted to another
-/// type, box filter, even level 0, without a full-resolution f32 copy of
-/// level 0: level 0 goes to the output type band by band (decode, alpha
-/// association, encode: elementwise, so the same bits as converting the
-/// decoded level whole), level 1 is filtered from level-0 rows decoded as
-/// they are read ([`mip::fast::box_f32_rows`]: the same kernel as the
-/// whole-level box), and the rest of the chain is built from level 1 in
-/// f32 as before. `None` when the shortcut does not apply (other filters,
-/// odd sizes, alpha coverage, float sources): the caller builds whole.
+/// type, box filter, even-sized levels, without a full-resolution f32 copy
+/// of any level: level 0 is cut into bands of 2^m rows (m ≤ 6 levels that
+/// halve exactly: both sides divisible by 2^m, m ≤ 4), and each band, on its own
+/// thread, is decoded to linear f32, reduced through levels 1..m with the
+/// box row kernel of the whole-level path ([`mip::fast`]), and every
+/// level's rows are alpha-associated and encoded into the output type as
+/// soon as they exist. Level m's f32 rows are kept (1/4^m of level 0) and
+/// the rest of the chain is built from them as before. Decoding, the row
+/// kernel, association and encoding are row-local, so the chain is bit for
+/// bit the whole-image one (`tests/mip_streamed.rs`).
 ///
-/// Memory at the peak (level 1 being filtered): the source, level 0 in the
-/// output type and level 1 in f32 — for RGBA8 → half EXR 4 + 8 + 4 bytes
-/// per level-0 texel, where decoding level 0 whole held 4 + 16 + 8.
+/// `Err(base)` hands the source back when the shortcut does not apply
+/// (other filters, odd sizes, alpha coverage, float sources): the caller
+/// builds whole. Memory: the source, the output chain and two threads'
+/// bands (about 1.4 × 16 level-0 rows of f32 each): for RGBA8 → half EXR
+/// 4 + 8 × 4/3 bytes per level-0 texel, where decoding level 0 whole held
+/// 4 + 16 + 8 × 4/3 at the end of the build.
 fn build_streamed(
-    base: &Texture,
+    base: Texture,
     options: &MipOptions,
     src: Format,
     out_format: Format,
     association: Option<AlphaMode>,
     progress: &mut dyn FnMut(mip::Progress),
-) -> Result<Option<Vec<Texture>>> {
+) -> Result<std::result::Result<Vec<Texture>, Texture>> {
     let (w, h) = (base.width() as usize, base.height() as usize);
     let sizes = mip::level_sizes(
         base.width(),
@@ -1247,29 +1256,29 @@ fn build_streamed(
         options.rounding,
         options.max_levels,
     );
-    let applies = options.filter == MipFilter::Box
+    let m = (w.trailing_zeros())
+        .min(h.trailing_zeros())
+        .min(STREAM_LEVELS)
+        .min(sizes.len() as u32 - 1) as usize;
+    let applies = cfg!(target_endian = "little")
+        && options.filter == MipFilter::Box
         && options.fast_paths
         && options.alpha_coverage.is_none()
         && !options.normal_map
         && matches!(src.channel_type, ChannelType::U8 | ChannelType::U16)
-        && w.is_multiple_of(2)
-        && h.is_multiple_of(2)
-        && sizes.len() >= 2
-        && sizes[1] == (base.width() / 2, base.height() / 2);
+        && m >= 1
+        && (0..=m).all(|k| sizes[k] == ((w >> k) as u32, (h >> k) as u32));
     if !applies {
-        return Ok(None);
+        return Ok(Err(base));
     }
     let ch = src.channels as usize;
     let f32fmt =
         Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
+    let straight = f32fmt
+        .alpha_channel()
+        .filter(|_| f32fmt.alpha == AlphaMode::Straight);
     let stored = base.format();
-    let decode_rows = |y0: usize, n: usize, out: &mut [f32]| match base.texels() {
-        Texels::U8(v) => crate::texel::decode_u8(&stored, &v[y0 * w * ch..(y0 + n) * w * ch], out),
-        Texels::U16(v) => {
-            crate::texel::decode_u16(&stored, &v[y0 * w * ch..(y0 + n) * w * ch], out)
-        }
-        _ => unreachable!("integer sources only"),
-    };
+    let rows = 1usize << m;
     let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
     let mut p = mip::Progress {
         levels_done: 1,
@@ -1278,74 +1287,99 @@ fn build_streamed(
         texels_total,
     };
     progress(p);
-    // Level 1 from rows decoded on the thread that filters them.
-    let straight = f32fmt
-        .alpha_channel()
-        .filter(|_| f32fmt.alpha == AlphaMode::Straight);
-    let (l1, _) = mip::fast::box_f32_rows(
-        &|j, out: &mut [f32]| decode_rows(j, 1, out),
-        w,
-        h,
-        f32fmt,
-        straight,
-    );
-    let level1 = Texture::from_f32(sizes[1].0, sizes[1].1, f32fmt, l1)?;
-    // Level 0 in the output type, band by band.
-    let narrow = Format {
-        channels: src.channels,
-        ..out_format
+    // One band: level-0 rows [b·rows, (b+1)·rows) → the band's rows of
+    // levels 0..=m in the output type, written into `dst[k]`, and level
+    // m's rows in f32 into `kept`.
+    let band = |b: usize, dst: &mut [&mut [u8]], kept: &mut [f32]| -> Result<()> {
+        let mut lin = vec![0f32; rows * w * ch];
+        let at = b * rows * w * ch..(b + 1) * rows * w * ch;
+        match base.texels() {
+            Texels::U8(v) => crate::texel::decode_u8(&stored, &v[at], &mut lin),
+            Texels::U16(v) => crate::texel::decode_u16(&stored, &v[at], &mut lin),
+            _ => unreachable!("integer sources only"),
+        }
+        let (mut lw, mut lr) = (w, rows);
+        for (k, d) in dst.iter_mut().enumerate() {
+            let t = Texture::from_f32(lw as u32, lr as u32, f32fmt, lin.clone())?;
+            let t = convert_level(associate(t, association)?, out_format)?;
+            d.copy_from_slice(&crate::io::le_bytes(t.texels()));
+            if k == m {
+                kept.copy_from_slice(&lin);
+                break;
+            }
+            let (nw, nr) = (lw / 2, lr / 2);
+            let mut next = vec![0f32; nw * nr * ch];
+            for (r, o) in next.chunks_exact_mut(nw * ch).enumerate() {
+                let r0 = &lin[2 * r * lw * ch..(2 * r + 1) * lw * ch];
+                let r1 = &lin[(2 * r + 1) * lw * ch..(2 * r + 2) * lw * ch];
+                mip::fast::box_row_f32(r0, r1, o, ch, straight);
+            }
+            (lw, lr, lin) = (nw, nr, next);
+        }
+        Ok(())
     };
-    let mut out0 = Texels::zeroed(
-        out_format.channel_type,
-        w * h * out_format.channels as usize,
-    );
+    // Every level's buffer, as little-endian bytes written in place by the
+    // bands on all threads (zero pages from the OS: no zeroing pass).
     let out_ch = out_format.channels as usize;
-    let mut band = vec![0f32; BAND_ROWS * w * ch];
-    for y0 in (0..h).step_by(BAND_ROWS) {
-        let n = BAND_ROWS.min(h - y0);
-        let lin = &mut band[..n * w * ch];
-        decode_rows(y0, n, lin);
-        let t = Texture::from_f32(w as u32, n as u32, f32fmt, lin.to_vec())?;
-        let t = convert_level(associate(t, association)?, out_format)?;
-        let at = y0 * w * out_ch..(y0 + n) * w * out_ch;
-        match (&mut out0, t.texels()) {
-            (Texels::U8(o), Texels::U8(v)) => o[at].copy_from_slice(v),
-            (Texels::U16(o), Texels::U16(v)) => o[at].copy_from_slice(v),
-            (Texels::F16(o), Texels::F16(v)) => o[at].copy_from_slice(v),
-            (Texels::F32(o), Texels::F32(v)) => o[at].copy_from_slice(v),
-            _ => {
-                return Err(Error::InvalidOption(format!(
-                    "internal: level 0 band converted to {}, expected {narrow}",
-                    t.format()
-                )));
+    let nbands = h / rows;
+    let mut outs: Vec<Texels> = (0..=m)
+        .map(|k| {
+            let n = sizes[k].0 as usize * sizes[k].1 as usize * out_ch;
+            Texels::zeroed(out_format.channel_type, n)
+        })
+        .collect();
+    let mut keep: Vec<f32> = crate::mem::zeroed(sizes[m].0 as usize * sizes[m].1 as usize * ch);
+    {
+        let mut lists: Vec<Vec<&mut [u8]>> =
+            (0..nbands).map(|_| Vec::with_capacity(m + 1)).collect();
+        for o in outs.iter_mut() {
+            // The typed buffer as bytes (little-endian host: the bytes
+            // `le_bytes` gives are the values' own).
+            let bytes: &mut [u8] = match o {
+                Texels::U8(v) => v,
+                Texels::U16(v) => bytemuck::cast_slice_mut(v),
+                Texels::F16(v) => bytemuck::cast_slice_mut(v),
+                Texels::F32(v) => bytemuck::cast_slice_mut(v),
+            };
+            let per = bytes.len() / nbands;
+            for (b, c) in bytes.chunks_mut(per).enumerate() {
+                lists[b].push(c);
             }
         }
+        let per_keep = keep.len() / nbands;
+        lists
+            .into_par_iter()
+            .zip(keep.par_chunks_mut(per_keep))
+            .enumerate()
+            .try_for_each(|(b, (mut l, kp))| band(b, &mut l, kp))?;
     }
-    let level0 = Texture::from_texels(base.width(), base.height(), out_format, out0)?;
-    p.levels_done = 2;
-    p.texels_done = sizes[1].0 as u64 * sizes[1].1 as u64;
+    drop(base);
+    let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len());
+    for (k, t) in outs.into_iter().enumerate() {
+        levels.push(Texture::from_texels(sizes[k].0, sizes[k].1, out_format, t)?);
+    }
+    p.levels_done = m as u32 + 1;
+    p.texels_done = sizes[1..=m].iter().map(|&(w, h)| w as u64 * h as u64).sum();
     progress(p);
-    // The rest from level 1, in f32, as the whole-level build does.
+    // The rest from level m, in f32, as the whole-level build does.
+    let level_m = Texture::from_f32(sizes[m].0, sizes[m].1, f32fmt, keep)?;
     let rest_options = MipOptions {
-        max_levels: Some(sizes.len() as u32 - 1),
+        max_levels: Some((sizes.len() - m) as u32),
         ..*options
     };
-    let done1 = p.texels_done;
-    let chain = mip::build_with_progress(level1, &rest_options, &mut |q| {
+    let done = p.texels_done;
+    let chain = mip::build_with_progress(level_m, &rest_options, &mut |q| {
         progress(mip::Progress {
-            levels_done: q.levels_done + 1,
+            levels_done: q.levels_done + m as u32,
             levels_total: sizes.len() as u32,
-            texels_done: done1 + q.texels_done,
+            texels_done: done + q.texels_done,
             texels_total,
         })
     })?;
-    let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len());
-    for l in chain.into_levels().into_iter().rev() {
+    for l in chain.into_levels().into_iter().skip(1) {
         levels.push(convert_level(associate(l, association)?, out_format)?);
     }
-    levels.push(level0);
-    levels.reverse();
-    Ok(Some(levels))
+    Ok(Ok(levels))
 }
 
 /// Texels with a channel outside [0, 1] (or NaN).

@@ -500,47 +500,19 @@ pub fn box_f32(src: &[f32], sw: usize, fmt: Format, straight: Option<usize>) -> 
     (dst, finite.load(Ordering::Relaxed))
 }
 
-/// [`box_f32`] of a level that is never held whole in f32: `row(j, out)`
-/// writes source row `j` (linear f32, `sw · channels` values) into `out`,
-/// each row asked for once, by the thread that filters it. The same row
-/// kernel runs on the same values, so the result is bit for bit that of
-/// [`box_f32`] on the whole decoded level (`tests/mip_streamed.rs`).
-pub fn box_f32_rows(
-    row: &(dyn Fn(usize, &mut [f32]) + Sync),
-    sw: usize,
-    sh: usize,
-    fmt: Format,
-    straight: Option<usize>,
-) -> (Vec<f32>, bool) {
-    use std::sync::atomic::{AtomicBool, Ordering};
-    let ch = fmt.channels as usize;
-    let (w, h) = (sw / 2, sh / 2);
-    let len = w * ch;
-    let mut dst: Vec<f32> = crate::mem::zeroed(len * h);
-    let per = rows_per_task(len * 4);
-    let finite = AtomicBool::new(ch == 4);
-    dst.par_chunks_mut(len * per).enumerate().for_each_init(
-        || (vec![0f32; sw * ch], vec![0f32; sw * ch]),
-        |(r0, r1), (task, out)| {
-            for (i, d) in out.chunks_exact_mut(len).enumerate() {
-                let y = task * per + i;
-                row(2 * y, r0);
-                row(2 * y + 1, r1);
-                if !box_row_f32(r0, r1, d, ch, straight) {
-                    finite.store(false, Ordering::Relaxed);
-                }
-            }
-        },
-    );
-    (dst, finite.load(Ordering::Relaxed))
-}
-
-/// One destination row of [`box_f32`] from source rows `r0` and `r1`;
+/// One destination row of [`box_f32`] from source rows `r0` and `r1`
+/// (`2·w·ch` values each; `d` gets `w·ch`);
 /// false when the RGBA kernel saw a non-finite output (the other kernels
 /// do not track it and return true only for RGBA's flag's sake: the
 /// caller starts from `ch == 4`).
 #[inline]
-fn box_row_f32(r0: &[f32], r1: &[f32], d: &mut [f32], ch: usize, straight: Option<usize>) -> bool {
+pub fn box_row_f32(
+    r0: &[f32],
+    r1: &[f32],
+    d: &mut [f32],
+    ch: usize,
+    straight: Option<usize>,
+) -> bool {
     match (ch, straight) {
         (4, _) => {
             let (alpha_differs, bad) = row_f32x4(r0, r1, d);
