@@ -28,6 +28,15 @@ pub enum WrapMode {
 }
 
 impl WrapMode {
+    /// Every mode, in declaration order.
+    pub const ALL: [WrapMode; 5] = [
+        WrapMode::Repeat,
+        WrapMode::MirroredRepeat,
+        WrapMode::ClampToEdge,
+        WrapMode::ClampToBorder,
+        WrapMode::MirrorClampToEdge,
+    ];
+
     /// The stable command-line name.
     pub fn name(self) -> &'static str {
         match self {
@@ -179,14 +188,7 @@ mod tests {
 
     #[test]
     fn every_mode_matches_the_spec_formula_at_negative_and_large_indices() {
-        let modes = [
-            WrapMode::Repeat,
-            WrapMode::MirroredRepeat,
-            WrapMode::ClampToEdge,
-            WrapMode::ClampToBorder,
-            WrapMode::MirrorClampToEdge,
-        ];
-        for mode in modes {
+        for mode in WrapMode::ALL {
             for size in [1i64, 2, 3, 5, 8, 13] {
                 let extra = [-(1i64 << 40) - 3, (1i64 << 40) + 7, -(1 << 62), 1 << 62];
                 for i in (-40..40).chain(extra) {

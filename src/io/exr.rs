@@ -765,6 +765,16 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
     let data_window = header.data_window();
     let display = header.shared_attributes.display_window;
     if data_window != display {
+        // Level 0 is placed in the display window: its size is what is
+        // allocated, so it is held to the limits too (an 8x8 data window
+        // in an 83886074x8 display window asked for 18 GB:
+        // tests/regression/exr_display_window_unbounded.rs).
+        let (dw, dh) = (display.size.width() as u64, display.size.height() as u64);
+        limits.check(
+            dw,
+            dh,
+            dw.saturating_mul(dh).saturating_mul(order.len() as u64 * 4),
+        )?;
         attributes.push((
             "dataWindow".into(),
             format!(

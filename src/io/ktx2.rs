@@ -524,7 +524,7 @@ fn read_bytes(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
 /// Read the fingerprint key of a KTX2 file written by parvo.
 pub fn stored_fingerprint(path: &Path) -> Option<String> {
     let bytes = std::fs::read(path).ok()?;
-    let r = ::ktx2::Reader::new(bytes.as_slice()).ok()?;
+    let r = reader(&bytes).ok()?;
     r.key_value_data()
         .find(|(k, _)| *k == FINGERPRINT_KEY)
         .map(|(_, v)| {
@@ -534,10 +534,69 @@ pub fn stored_fingerprint(path: &Path) -> Option<String> {
         })
 }
 
-/// Load a KTX2 file: every mip level of an uncompressed 2-D texture.
+/// The premultiplied-alpha flag of the first basic DFD block, read from
+/// the bytes (not through the `ktx2` crate's DFD parser: see [`reader`]).
+fn dfd_premultiplied(bytes: &[u8]) -> bool {
+    let word = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    // dfdByteOffset; then the total size word, the vendor/type word, the
+    // version/size word, and the model/primaries/transfer/flags word.
+    let Some(at) = word(48).map(|a| a as usize) else {
+        return false;
+    };
+    at.checked_add(12)
+        .and_then(word)
+        .is_some_and(|w| (w >> 24) & 1 == 1)
+}
+
+/// The `ktx2` crate's reader of `bytes`, after the checks it lacks: its
+/// DFD parser panics (`NonZeroU8::new(dim + 1).unwrap()`) on a texel
+/// block dimension byte of 255, so every basic DFD block is checked
+/// first, and any other panic inside the crate becomes an error.
+fn reader(bytes: &[u8]) -> Result<::ktx2::Reader<&[u8]>> {
+    let word = |at: usize| {
+        bytes
+            .get(at..at.checked_add(4)?)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    if let (Some(at), Some(len)) = (word(48), word(52)) {
+        let (start, len) = (at as usize, len as usize);
+        let end = start.saturating_add(len).min(bytes.len());
+        // After the total size word: blocks of vendor/type, version/size.
+        let mut b = start.saturating_add(4);
+        while b.saturating_add(16) <= end {
+            let (Some(head), Some(size)) = (word(b), word(b + 4)) else {
+                break;
+            };
+            let size = (size >> 16) as usize;
+            if head == 0 && bytes[b + 12..b + 16].contains(&255) {
+                return Err(decode_err(
+                    "the data format descriptor gives a texel block dimension of 256",
+                ));
+            }
+            if size == 0 {
+                break;
+            }
+            b = b.saturating_add(size);
+        }
+    }
+    std::panic::catch_unwind(|| ::ktx2::Reader::new(bytes))
+        .map_err(|_| decode_err("malformed file (the KTX2 parser failed)"))?
+        .map_err(decode_err)
+}
+
+/// Load a KTX2 file: every mip level of a 2-D texture (uncompressed, or
+/// BC1–BC7, optionally zstd/zlib supercompressed).
 pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     let bytes = read_bytes(path, limits)?;
-    let r = ::ktx2::Reader::new(bytes.as_slice()).map_err(decode_err)?;
+    load_bytes(&bytes, limits)
+}
+
+fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
+    let r = reader(bytes)?;
     let h = r.header();
     if h.pixel_depth > 1 || h.layer_count > 1 || h.face_count != 1 {
         return Err(decode_err(
@@ -556,7 +615,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
             ))
         })?,
     };
-    let premultiplied = r.is_alpha_premultiplied() == Some(true);
+    let premultiplied = dfd_premultiplied(bytes);
     if premultiplied && format.has_alpha() {
         format = format.with_alpha(AlphaMode::Premultiplied);
     }
