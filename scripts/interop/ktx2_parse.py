@@ -1,0 +1,54 @@
+#!/usr/bin/env python3
+"""KTX2 interop: ktx-parse (npm, pinned 1.1.0; installed into
+target/interop-node by this script) reads the KTX2 files parvo writes:
+uncompressed, every block format, zstd and zlib supercompressed. The
+vkFormat, typeSize, size, level count, supercompression scheme, DFD colour
+model, transfer, texel block and bytesPlane0 it reports must be what the
+KTX 2.0 specification says for the file, and each level's
+uncompressedByteLength what the level needs.
+"""
+import json
+import os
+import subprocess
+
+from common import args, check, finish, run
+
+parvo, venv_bin, work = args()
+root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+node_dir = os.path.join(root, "target", "interop-node")
+if not os.path.isdir(os.path.join(node_dir, "node_modules", "ktx-parse")):
+    os.makedirs(node_dir, exist_ok=True)
+    subprocess.run(["npm", "install", "--prefix", node_dir, "--no-audit", "--no-fund", "ktx-parse@1.1.0"],
+                   check=True, capture_output=True)
+reader = os.path.join(os.path.dirname(os.path.abspath(__file__)), "ktx2_read.cjs")
+os.environ["NODE_PATH"] = os.path.join(node_dir, "node_modules")
+
+N = 61  # odd: partial blocks on every level
+# (name, parvo args, vkFormat, typeSize, colour model, transfer, block, bytesPlane0, bytes of a level)
+blocks = lambda b: (lambda w, h: ((w + 3) // 4) * ((h + 3) // 4) * b)
+CASES = [
+    ("RGB8 sRGB", [], 29, 1, 1, 2, [0, 0, 0, 0], 3, lambda w, h: w * h * 3),
+    ("BC1", ["--compress", "bc1"], 132, 1, 128, 2, [3, 3, 0, 0], 8, blocks(8)),
+    ("BC3", ["--compress", "bc3"], 138, 1, 130, 2, [3, 3, 0, 0], 16, blocks(16)),
+    ("BC4", ["--compress", "bc4"], 139, 1, 131, 1, [3, 3, 0, 0], 8, blocks(8)),
+    ("BC5", ["--compress", "bc5"], 141, 1, 132, 1, [3, 3, 0, 0], 16, blocks(16)),
+    ("BC7", ["--compress", "bc7", "--quality", "fast"], 146, 1, 134, 2, [3, 3, 0, 0], 16, blocks(16)),
+]
+for name, extra, vk, ts, model, transfer, block, plane, need in CASES:
+    for sc in ([], ["--zstd", "9"], ["--zlib", "6"]):
+        what = f"{name} {' '.join(sc) or 'plain'}"
+        path = f"{work}/t.ktx2"
+        r = run(parvo, "mip", f"builtin:photo:{N}", "-o", path, *extra, *sc)
+        if not check(r.returncode == 0, f"parvo writes {what} KTX2"):
+            continue
+        r = run("node", reader, path)
+        if not check(r.returncode == 0, f"ktx-parse reads parvo's {what} KTX2", r.stderr.strip()[-300:]):
+            continue
+        d = json.loads(r.stdout)
+        scheme = {"": 0, "--zstd": 2, "--zlib": 3}[sc[0] if sc else ""]
+        sizes = [(max(N >> k, 1), max(N >> k, 1)) for k in range(d["levels"])]
+        got = (d["vkFormat"], d["typeSize"], d["width"], d["height"], d["levels"], d["scheme"],
+               d["model"], d["transfer"], d["block"], d["bytesPlane0"], d["uncompressed"])
+        want = (vk, ts, N, N, 6, scheme, model, transfer, block, plane, [need(w, h) for w, h in sizes])
+        check(got == want, f"ktx-parse finds parvo's {what} KTX2 fields as specified", f"got {got}, want {want}")
+finish()
