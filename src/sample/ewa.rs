@@ -30,7 +30,11 @@
 //! texel), texels alternating between two sets of `f32` sums; the bounds
 //! of each run are solved eight runs at a time. On CPUs with AVX2 and FMA
 //! the same code is compiled for them with fused multiply-adds (so the
-//! last bits differ from the portable build). `ewa_exact` (public as
+//! last bits differ from the portable build). On CPUs with AVX-512 (F,
+//! BW, DQ, VL, VBMI), untraced lookups of packed RGBA8 chains stage the
+//! in-level runs end to end and sum them 16 texels at a time
+//! (`ewa_simd.rs`; [`super::Sampler::set_simd`] and `PARVO_NO_AVX`
+//! turn it off). `ewa_exact` (public as
 //! [`super::Sampler::sample_ewa_exact`]) keeps the plain form (`exp` per
 //! texel, every fetch wrapped, `f64` sums): the reference the tests hold
 //! both paths to (within 1e-3).
@@ -66,6 +70,12 @@ const ALPHA: f64 = 2.0;
 /// EWA lookup of `q` (the fast path, see the module docs): the same code
 /// compiled for AVX2 and FMA when the CPU has them (fused multiply-adds
 /// there, so results differ from the portable build in the last bits).
+///
+/// With `avx512` (the sampler's AVX-512 table exists: the CPU has AVX-512
+/// F, BW, DQ, VL and VBMI and `PARVO_NO_AVX` is unset) a lookup of a
+/// packed RGBA8 chain sums its runs with `ewa_simd.rs` (traced or not:
+/// both give the same result, bit for bit).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn ewa<P: Pixel, S: TexelSink>(
     c: &Chain<P>,
     a: &Addressing,
@@ -73,15 +83,45 @@ pub(crate) fn ewa<P: Pixel, S: TexelSink>(
     o: &SamplerOptions,
     q: &Query,
     sink: &mut S,
+    avx512: bool,
 ) -> [f32; 4] {
     #[cfg(target_arch = "x86_64")]
-    if crate::cpu::avx2_fma() {
-        #[allow(unsafe_code)]
-        // SAFETY: `avx2_fma()` checked that the CPU has AVX2 and FMA, the
-        // only features `ewa_avx2` is compiled for.
-        return unsafe { ewa_avx2(c, a, lod, o, q, sink) };
+    {
+        if avx512 && vector_texels(c) {
+            #[allow(unsafe_code)]
+            // SAFETY: the caller's `avx512` says the CPU has AVX-512 F, BW,
+            // DQ, VL and VBMI; every AVX-512 CPU also has AVX2 and FMA.
+            return unsafe { ewa_avx512(c, a, lod, o, q, sink) };
+        }
+        if crate::cpu::avx2_fma() {
+            #[allow(unsafe_code)]
+            // SAFETY: `avx2_fma()` checked that the CPU has AVX2 and FMA,
+            // the only features `ewa_avx2` is compiled for.
+            return unsafe { ewa_avx2(c, a, lod, o, q, sink) };
+        }
     }
-    ewa_impl::<P, S, false, false>(c, a, lod, o, q, sink)
+    let _ = avx512;
+    ewa_impl::<P, S, false, false, false>(c, a, lod, o, q, sink)
+}
+
+/// True when `c`'s texels are packed RGBA8 with one decode table for the
+/// colour channels: what [`super::ewa_simd`] reads.
+#[inline(always)]
+fn vector_texels<P: Pixel>(c: &Chain<P>) -> bool {
+    std::mem::size_of::<P>() == 4 && P::packed(&c.lut).is_some_and(|l| l.shared)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn ewa_avx512<P: Pixel, S: TexelSink>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    o: &SamplerOptions,
+    q: &Query,
+    sink: &mut S,
+) -> [f32; 4] {
+    ewa_impl::<P, S, false, true, true>(c, a, lod, o, q, sink)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -94,7 +134,7 @@ fn ewa_avx2<P: Pixel, S: TexelSink>(
     q: &Query,
     sink: &mut S,
 ) -> [f32; 4] {
-    ewa_impl::<P, S, false, true>(c, a, lod, o, q, sink)
+    ewa_impl::<P, S, false, true, false>(c, a, lod, o, q, sink)
 }
 
 /// EWA with the weights computed by `exp` per texel, every fetch wrapped
@@ -107,11 +147,11 @@ pub(crate) fn ewa_exact<P: Pixel, S: TexelSink>(
     q: &Query,
     sink: &mut S,
 ) -> [f32; 4] {
-    ewa_impl::<P, S, true, false>(c, a, lod, o, q, sink)
+    ewa_impl::<P, S, true, false, false>(c, a, lod, o, q, sink)
 }
 
 #[inline(always)]
-fn ewa_impl<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool>(
+fn ewa_impl<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const VEC: bool>(
     c: &Chain<P>,
     a: &Addressing,
     lod: &Lod,
@@ -167,9 +207,9 @@ fn ewa_impl<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool>(
         xy: (major2 - minor2) * exy,
         yy: major2 * eyy + minor2 * exx,
     };
-    let t = ewa_level::<P, S, EXACT, FMA>(c, hi, a, &axes, u, v, sink);
+    let t = ewa_level::<P, S, EXACT, FMA, VEC>(c, hi, a, &axes, u, v, sink);
     if delta > 0.0 && lo != hi {
-        let t2 = ewa_level::<P, S, EXACT, FMA>(c, lo, a, &axes, u, v, sink);
+        let t2 = ewa_level::<P, S, EXACT, FMA, VEC>(c, lo, a, &axes, u, v, sink);
         lerp(t, t2, delta)
     } else {
         t
@@ -184,20 +224,23 @@ struct Axes {
     yy: f64,
 }
 
+/// The coefficients of [`weight_poly`], lowest power first.
+pub(crate) const WEIGHT_POLY: [f32; 7] = [
+    0.864_663_4,
+    -1.999_869_1,
+    1.997_875_8,
+    -1.320_221_6,
+    0.627_286_2,
+    -0.203_470_2,
+    0.033_736_594,
+];
+
 /// `exp(−2x) − exp(−2)` on [0, 1] as a degree-6 polynomial (Chebyshev
 /// interpolation, converted to powers; within 1.4·10⁻⁶ of the formula),
 /// kept above 0 inside the ellipse.
 #[inline(always)]
 fn weight_poly<const FMA: bool>(x: f32) -> f32 {
-    const C: [f32; 7] = [
-        0.864_663_4,
-        -1.999_869_1,
-        1.997_875_8,
-        -1.320_221_6,
-        0.627_286_2,
-        -0.203_470_2,
-        0.033_736_594,
-    ];
+    const C: [f32; 7] = WEIGHT_POLY;
     // Estrin's scheme: three multiply-adds deep instead of six.
     let x2 = x * x;
     let p01 = madd::<FMA>(C[1], x, C[0]);
@@ -212,7 +255,7 @@ fn weight_poly<const FMA: bool>(x: f32) -> f32 {
 }
 
 #[inline(always)]
-fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool>(
+fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const VEC: bool>(
     c: &Chain<P>,
     k: usize,
     a: &Addressing,
@@ -263,7 +306,7 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool>(
     // than tall, columns otherwise (the per-run setup is the cost of short
     // runs; a grazing plane's ellipses run along v).
     let (acc, wsum) = if css >= ctt {
-        scan::<P, S, false, FMA>(
+        scan::<P, S, false, FMA, VEC>(
             l,
             c,
             k,
@@ -275,7 +318,7 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool>(
             sink,
         )
     } else {
-        scan::<P, S, true, FMA>(
+        scan::<P, S, true, FMA, VEC>(
             l,
             c,
             k,
@@ -321,7 +364,7 @@ fn floor_small<const AVX2: bool>(x: f32) -> f32 {
 /// the level are read without wrapping.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool>(
+fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool, const VEC: bool>(
     l: &super::fetch::Level<P>,
     c: &Chain<P>,
     lv: usize,
@@ -343,6 +386,10 @@ fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool>(
     let inv2a = 0.5 / qa;
     let tt0 = (t0 as f64 - ft) as f32;
     let dd = 2.0 * qa;
+    // With VEC, runs inside the level are staged for the AVX-512 sums
+    // (`lut8` is then always `Some`: `ewa` checked the texels).
+    #[cfg(target_arch = "x86_64")]
+    let (mut staged, lut8) = (super::ewa_simd::Runs::new(), P::packed(&c.lut));
     // Eight lines at a time: their runs solved together (vectorised), then
     // walked one by one.
     for base in (0..n).step_by(8) {
@@ -391,12 +438,29 @@ fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool>(
                 };
                 let run = &l.texels[start..=start + (n - 1) * stride];
                 // Tracing sinks hear of each texel with a weight (the same test
-                // as the sum's, on the same stepped r²).
+                // as the sum's, on the same r²).
                 let mut hit = |k: usize| {
                     let x = x0 + k as i64;
                     let (tx, ty) = if COLUMNS { (line, x) } else { (x, line) };
                     sink.texel(lv as u32, tx as u32, ty as u32);
                 };
+                #[cfg(target_arch = "x86_64")]
+                if VEC
+                    && stride <= (i32::MAX / 16) as usize
+                    && n <= 256
+                    && let Some(lut8) = lut8
+                {
+                    #[allow(unsafe_code)]
+                    // SAFETY: VEC is set only by `ewa_avx512`, run on CPUs
+                    // with AVX-512 F, BW, DQ, VL and VBMI, for 4-byte texels
+                    // (`vector_texels`); `run` holds the run's n ≤ 256
+                    // texels `stride` apart, and 15·stride fits an i32.
+                    unsafe {
+                        let first = run.as_ptr().cast();
+                        staged.push(lut8, first, stride, n, (r2, d, dd), S::TRACES, &mut hit);
+                    }
+                    continue;
+                }
                 let (t, ws) = if stride == 1 {
                     run_sum::<P, S, FMA>(run.iter(), &c.lut, (r2, d, dd), &mut hit)
                 } else {
@@ -425,6 +489,13 @@ fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool>(
                 }
             }
         }
+    }
+    #[cfg(target_arch = "x86_64")]
+    if VEC && let Some(lut8) = lut8 {
+        #[allow(unsafe_code)]
+        // SAFETY: VEC is set only by `ewa_avx512` (see the push).
+        let (t, ws) = unsafe { staged.finish(lut8) };
+        return ([a0 + t[0], a1 + t[1], a2 + t[2], a3 + t[3]], wsum + ws);
     }
     ([a0, a1, a2, a3], wsum)
 }

@@ -79,6 +79,8 @@ mod aniso;
 mod batch;
 mod bilinear;
 pub mod ewa;
+#[cfg(target_arch = "x86_64")]
+mod ewa_simd;
 pub mod fetch;
 pub mod footprint;
 mod query;
@@ -674,7 +676,10 @@ impl Sampler {
     /// Allows (`true`, the default) or forbids the AVX-512 path of
     /// [`uses_simd`](Self::uses_simd) for this sampler. The results are
     /// the same bit for bit; forbidding it times the portable code, or
-    /// rules the SIMD code out while debugging. Allowing it does nothing
+    /// rules the SIMD code out while debugging. It also governs the
+    /// AVX-512 sums of EWA on packed RGBA8 chains (untraced), whose
+    /// results differ from the AVX2 build's in the last bits (both are
+    /// within 1e-3 of [`sample_ewa_exact`](Self::sample_ewa_exact)). Allowing it does nothing
     /// where the CPU, `PARVO_NO_AVX` or the texture format rule it out.
     pub fn set_simd(&mut self, allowed: bool) {
         #[cfg(target_arch = "x86_64")]
@@ -750,7 +755,13 @@ impl Sampler {
         match self.kernel {
             Kernel::Isotropic => self.run_filters::<P, S, false>(c, queries, out, sink),
             Kernel::Texel => self.run_filters::<P, S, true>(c, queries, out, sink),
-            Kernel::Ewa => each(queries, out, |q| ewa::ewa(c, a, lod, o, q, sink)),
+            Kernel::Ewa => {
+                #[cfg(target_arch = "x86_64")]
+                let avx512 = self.simd.is_some();
+                #[cfg(not(target_arch = "x86_64"))]
+                let avx512 = false;
+                each(queries, out, |q| ewa::ewa(c, a, lod, o, q, sink, avx512))
+            }
             Kernel::Supersample => each(queries, out, |q| {
                 supersample::supersample(c, a, lod, o, q, sink)
             }),

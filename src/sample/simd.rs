@@ -291,8 +291,7 @@ fn widen(codes: __m512i, pattern: [i32; 4]) -> __m512 {
 
 /// The 2×2 blocks of 4 lanes of a packed RGBA8 chain, decoded: register
 /// `c` holds corner `c` (00, 10, 01, 11) of lane `j` in 128-bit group
-/// `j`, as RGBA `f32`. The 64 codes are looked up in the four byte planes
-/// of the decode table and the planes interleaved back into `f32`s.
+/// `j`, as RGBA `f32` ([`decode_rgba8`] of the 16 texels).
 ///
 /// # Safety
 /// The addresses satisfy [`read`] for 8 bytes.
@@ -310,6 +309,17 @@ unsafe fn group_rgba8(lut: &Lut8, top: &[u64], bot: &[u64]) -> [__m512; 4] {
         _mm512_castsi256_si512(_mm256_set_m128i(x[1], x[0])),
         _mm256_set_m128i(x[3], x[2]),
     );
+    decode_rgba8(lut, codes)
+}
+
+/// 16 packed RGBA8 texels (one per 32-bit lane of `codes`), decoded:
+/// register `c` holds texel `4j + c` in 128-bit group `j`, as RGBA `f32`.
+/// The 64 codes are looked up in the four byte planes of the decode table
+/// and the planes interleaved back into `f32`s (linear channels are
+/// converted and scaled instead).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+pub(crate) fn decode_rgba8(lut: &Lut8, codes: __m512i) -> [__m512; 4] {
     if lut.colour_linear && (lut.alpha_same || lut.alpha_linear) {
         return [
             widen(codes, [dw(0), dw(1), dw(2), dw(3)]),
