@@ -210,7 +210,12 @@ pub fn build(
                 Specular::BlinnPhong(e) => toksvig_exponent(e, r),
                 Specular::Roughness => {
                     let a = match (&alpha_k, base) {
-                        (Some(a), _) => a[i],
+                        // A map's chain is filtered like colour: the
+                        // negative lobes of Kaiser, Lanczos and Mitchell
+                        // ring past 0 and 1 at sharp edges, and roughness
+                        // outside [0, 1] means nothing (fuzzing found
+                        // −0.012 in the output).
+                        (Some(a), _) => a[i].clamp(0.0, 1.0),
                         (None, BaseRoughness::Constant(a)) => a,
                         (None, BaseRoughness::Map(_)) => unreachable!("maps are built above"),
                     };

@@ -111,8 +111,7 @@ impl Axis {
     /// within ±2⁵²) of an axis of `n ≥ 1` texels under `mode`.
     pub(crate) fn new(mode: WrapMode, x0: f64, x1: f64, n: u32) -> Axis {
         let n64 = n as i64;
-        let (i0, i1) = (floor_index(x0), floor_index(x1));
-        let (a0, a1) = (frac(x0, i0), frac(x1, i1));
+        let ((i0, a0), (i1, a1)) = (split(x0), split(x1));
         if i0 >= 0 && (i1 < n64 || (i1 == n64 && a1 == 0.0)) {
             return Self::inside(x0, x1, i0, a0, i1, a1);
         }
@@ -193,9 +192,20 @@ impl Axis {
 /// Fractional part of `x` given its floor index (0 when `x` is so large
 /// that it has none).
 #[inline]
-fn frac(x: f64, i: i64) -> f64 {
+/// `x` as a texel index and the fraction of that texel before it, `x =
+/// i + a` with `0 ≤ a < 1`. Just below an integer `k`, `x − floor(x)`
+/// rounds to 1 (−2⁻¹⁰⁰ − (−1) is 1 in `f64`): that is `k` itself, `(k,
+/// 0)`, not `(k − 1, 0)`, a whole texel off (fuzzing found the case).
+fn split(x: f64) -> (i64, f64) {
+    let i = floor_index(x);
     let f = x - i as f64;
-    if (0.0..1.0).contains(&f) { f } else { 0.0 }
+    if (0.0..1.0).contains(&f) {
+        (i, f)
+    } else if f >= 1.0 {
+        (i.saturating_add(1), 0.0)
+    } else {
+        (i, 0.0)
+    }
 }
 
 #[cfg(test)]

@@ -21,6 +21,8 @@ mod multipart_and_multipage_silently_first;
 mod normal_maps_filtered_as_encoded_codes;
 mod png_colour_chunks_ignored;
 mod premultiplied_exr_written_premultiplied_to_png;
+mod roughness_map_ringing_went_below_zero;
 mod rounding_up_writes_invalid_ktx2;
 mod sample_ignores_recorded_wrap_modes;
+mod sat_rect_end_just_below_zero_read_a_texel_off;
 mod tiff_associated_alpha_premultiplied_twice;
