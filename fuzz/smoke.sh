@@ -10,7 +10,7 @@ cd "$(dirname "$0")"
 cargo build --release --quiet --bins
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
-for t in decode_and_mip parsers compress sampler; do
+for t in decode_and_mip parsers compress sampler sat cachesim normal_roughness; do
     mkdir -p "$WORK/$t"
     # New inputs go to the first (scratch) directory; the seeds stay as
     # they are.
