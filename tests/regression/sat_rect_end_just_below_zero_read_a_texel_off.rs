@@ -50,7 +50,7 @@ fn edges_just_below_zero_match_brute_force_in_every_mode() {
     )
     .unwrap();
     let border = [0.5f32; 4];
-    for tiny in [1e-300, 2e-113, 1e-20, 1e-17] {
+    for tiny in [1e-300f64, 2e-113, 1e-20, 1e-17] {
         for (x0, x1) in [(-2.5, -tiny), (-tiny, 3.25), (-7.75, -tiny), (-tiny, 0.5)] {
             for mode in WrapMode::ALL {
                 // Brute force: the texels cut by [x0, x1), each weighted
