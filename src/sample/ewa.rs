@@ -30,11 +30,14 @@
 //! texel), texels alternating between two sets of `f32` sums; the bounds
 //! of each run are solved eight runs at a time. On CPUs with AVX2 and FMA
 //! the same code is compiled for them with fused multiply-adds (so the
-//! last bits differ from the portable build). On CPUs with AVX-512 (F,
-//! BW, DQ, VL, VBMI), untraced lookups of packed RGBA8 chains stage the
-//! in-level runs end to end and sum them 16 texels at a time
-//! (`ewa_simd.rs`; [`super::Sampler::set_simd`] and `PARVO_NO_AVX`
-//! turn it off). `ewa_exact` (public as
+//! last bits differ from the portable build). Lookups are set up in
+//! blocks of 16 (ellipse, λ, levels and their quadratic forms for every
+//! query of the block) before any texel is read. On CPUs with AVX-512 (F,
+//! BW, DQ, VL, VBMI), lookups of packed RGBA8 chains (traced or not)
+//! solve 16 lines at a time, sweep the rows of an ellipse taller than
+//! wide instead of gathering down its columns, stage the texels end to
+//! end and sum them 16 at a time (`ewa_simd.rs`;
+//! [`super::Sampler::set_simd`] and `PARVO_NO_AVX` turn it off). `ewa_exact` (public as
 //! [`super::Sampler::sample_ewa_exact`]) keeps the plain form (`exp` per
 //! texel, every fetch wrapped, `f64` sums): the reference the tests hold
 //! both paths to (within 1e-3).
@@ -67,41 +70,43 @@ pub const MAX_RADIUS: f64 = 40.0;
 /// Gaussian falloff α of the EWA weight `exp(−α·r²) − exp(−α)`.
 const ALPHA: f64 = 2.0;
 
-/// EWA lookup of `q` (the fast path, see the module docs): the same code
-/// compiled for AVX2 and FMA when the CPU has them (fused multiply-adds
-/// there, so results differ from the portable build in the last bits).
+/// EWA lookups of `queries` into `out` (the fast path, see the module
+/// docs): the same code compiled for AVX2 and FMA when the CPU has them
+/// (fused multiply-adds there, so results differ from the portable build
+/// in the last bits).
 ///
 /// With `avx512` (the sampler's AVX-512 table exists: the CPU has AVX-512
-/// F, BW, DQ, VL and VBMI and `PARVO_NO_AVX` is unset) a lookup of a
-/// packed RGBA8 chain sums its runs with `ewa_simd.rs` (traced or not:
+/// F, BW, DQ, VL and VBMI and `PARVO_NO_AVX` is unset) lookups of a
+/// packed RGBA8 chain sum their texels with `ewa_simd.rs` (traced or not:
 /// both give the same result, bit for bit).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn ewa<P: Pixel, S: TexelSink>(
+pub(crate) fn ewa_slice<P: Pixel, S: TexelSink>(
     c: &Chain<P>,
     a: &Addressing,
     lod: &Lod,
     o: &SamplerOptions,
-    q: &Query,
+    queries: &[Query],
+    out: &mut [[f32; 4]],
     sink: &mut S,
     avx512: bool,
-) -> [f32; 4] {
+) {
     #[cfg(target_arch = "x86_64")]
     {
         if avx512 && vector_texels(c) {
             #[allow(unsafe_code)]
             // SAFETY: the caller's `avx512` says the CPU has AVX-512 F, BW,
             // DQ, VL and VBMI; every AVX-512 CPU also has AVX2 and FMA.
-            return unsafe { ewa_avx512(c, a, lod, o, q, sink) };
+            return unsafe { ewa_avx512(c, a, lod, o, queries, out, sink) };
         }
         if crate::cpu::avx2_fma() {
             #[allow(unsafe_code)]
             // SAFETY: `avx2_fma()` checked that the CPU has AVX2 and FMA,
             // the only features `ewa_avx2` is compiled for.
-            return unsafe { ewa_avx2(c, a, lod, o, q, sink) };
+            return unsafe { ewa_avx2(c, a, lod, o, queries, out, sink) };
         }
     }
     let _ = avx512;
-    ewa_impl::<P, S, false, false, false>(c, a, lod, o, q, sink)
+    blocks::<P, S, false, false>(c, a, lod, o, queries, out, sink)
 }
 
 /// True when `c`'s texels are packed RGBA8 with one decode table for the
@@ -118,10 +123,11 @@ fn ewa_avx512<P: Pixel, S: TexelSink>(
     a: &Addressing,
     lod: &Lod,
     o: &SamplerOptions,
-    q: &Query,
+    queries: &[Query],
+    out: &mut [[f32; 4]],
     sink: &mut S,
-) -> [f32; 4] {
-    ewa_impl::<P, S, false, true, true>(c, a, lod, o, q, sink)
+) {
+    blocks::<P, S, true, true>(c, a, lod, o, queries, out, sink)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -131,10 +137,39 @@ fn ewa_avx2<P: Pixel, S: TexelSink>(
     a: &Addressing,
     lod: &Lod,
     o: &SamplerOptions,
-    q: &Query,
+    queries: &[Query],
+    out: &mut [[f32; 4]],
     sink: &mut S,
-) -> [f32; 4] {
-    ewa_impl::<P, S, false, true, false>(c, a, lod, o, q, sink)
+) {
+    blocks::<P, S, true, false>(c, a, lod, o, queries, out, sink)
+}
+
+/// Queries set up together before their texels are read.
+const BLOCK: usize = 16;
+
+/// The fast path in two passes per block of [`BLOCK`] queries: first
+/// every query's setup (its ellipse, levels and their quadratic forms:
+/// long chains of dependent arithmetic, independent between queries, so
+/// they overlap), then each query's texels.
+#[inline(always)]
+fn blocks<P: Pixel, S: TexelSink, const FMA: bool, const VEC: bool>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    o: &SamplerOptions,
+    queries: &[Query],
+    out: &mut [[f32; 4]],
+    sink: &mut S,
+) {
+    let mut setups = [Setup::NONE; BLOCK];
+    for (qs, os) in queries.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+        for (q, st) in qs.iter().zip(setups.iter_mut()) {
+            *st = setup(c, a, lod, o, q);
+        }
+        for (st, o) in setups.iter().zip(os.iter_mut()) {
+            *o = read::<P, S, false, FMA, VEC>(c, a, st, sink);
+        }
+    }
 }
 
 /// EWA with the weights computed by `exp` per texel, every fetch wrapped
@@ -147,18 +182,56 @@ pub(crate) fn ewa_exact<P: Pixel, S: TexelSink>(
     q: &Query,
     sink: &mut S,
 ) -> [f32; 4] {
-    ewa_impl::<P, S, true, false, false>(c, a, lod, o, q, sink)
+    let st = setup(c, a, lod, o, q);
+    read::<P, S, true, false, false>(c, a, &st, sink)
 }
 
+/// What one lookup reads: one or two levels, blended by `delta`.
+#[derive(Clone, Copy)]
+struct Setup {
+    levels: [LevelSetup; 2],
+    two: bool,
+    delta: f32,
+}
+
+/// One level of a lookup: level `k`, read once at texel (0, 0) when
+/// `single`, else its ellipse `Σ = (Σss, Σst, Σtt)` (SPEC's `A, B, C`
+/// over `F` in `q`) centred at `base + frac` in texel-centre coordinates.
+#[derive(Clone, Copy)]
+struct LevelSetup {
+    k: usize,
+    single: bool,
+    sigma: (f64, f64, f64),
+    q: (f64, f64, f64),
+    base: (i64, i64),
+    frac: (f64, f64),
+}
+
+impl Setup {
+    const NONE: Setup = Setup {
+        levels: [LevelSetup {
+            k: 0,
+            single: true,
+            sigma: (1.0, 0.0, 1.0),
+            q: (1.0, 0.0, 1.0),
+            base: (0, 0),
+            frac: (0.0, 0.0),
+        }; 2],
+        two: false,
+        delta: 0.0,
+    };
+}
+
+/// The levels and ellipses lookup `q` reads (steps 1–3 of the module
+/// docs, and step 4 up to the texels).
 #[inline(always)]
-fn ewa_impl<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const VEC: bool>(
+fn setup<P: Pixel>(
     c: &Chain<P>,
     a: &Addressing,
     lod: &Lod,
     o: &SamplerOptions,
     q: &Query,
-    sink: &mut S,
-) -> [f32; 4] {
+) -> Setup {
     let (u, v) = lod.reduce(q);
     let (dx, dy) = derivatives(q, lod.wf, lod.hf);
     let levels = &c.levels[..];
@@ -207,10 +280,29 @@ fn ewa_impl<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const VE
         xy: (major2 - minor2) * exy,
         yy: major2 * eyy + minor2 * exx,
     };
-    let t = ewa_level::<P, S, EXACT, FMA, VEC>(c, hi, a, &axes, u, v, sink);
-    if delta > 0.0 && lo != hi {
-        let t2 = ewa_level::<P, S, EXACT, FMA, VEC>(c, lo, a, &axes, u, v, sink);
-        lerp(t, t2, delta)
+    let two = delta > 0.0 && lo != hi;
+    Setup {
+        levels: [
+            level_setup(c, hi, a, &axes, u, v),
+            level_setup(c, if two { lo } else { hi }, a, &axes, u, v),
+        ],
+        two,
+        delta,
+    }
+}
+
+/// Read what `st` says and blend.
+#[inline(always)]
+fn read<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const VEC: bool>(
+    c: &Chain<P>,
+    a: &Addressing,
+    st: &Setup,
+    sink: &mut S,
+) -> [f32; 4] {
+    let t = ewa_level::<P, S, EXACT, FMA, VEC>(c, a, &st.levels[0], sink);
+    if st.two {
+        let t2 = ewa_level::<P, S, EXACT, FMA, VEC>(c, a, &st.levels[1], sink);
+        lerp(t, t2, st.delta)
     } else {
         t
     }
@@ -239,7 +331,7 @@ pub(crate) const WEIGHT_POLY: [f32; 7] = [
 /// interpolation, converted to powers; within 1.4·10⁻⁶ of the formula),
 /// kept above 0 inside the ellipse.
 #[inline(always)]
-fn weight_poly<const FMA: bool>(x: f32) -> f32 {
+pub(crate) fn weight_poly<const FMA: bool>(x: f32) -> f32 {
     const C: [f32; 7] = WEIGHT_POLY;
     // Estrin's scheme: three multiply-adds deep instead of six.
     let x2 = x * x;
@@ -254,25 +346,23 @@ fn weight_poly<const FMA: bool>(x: f32) -> f32 {
     if p > 1e-12 { p } else { 1e-12 }
 }
 
+/// Level `k`'s part of a lookup with the (lengthened) ellipse `axes`
+/// centred at `(u, v)`.
 #[inline(always)]
-fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const VEC: bool>(
+fn level_setup<P: Pixel>(
     c: &Chain<P>,
     k: usize,
     a: &Addressing,
     axes: &Axes,
     u: f64,
     v: f64,
-    sink: &mut S,
-) -> [f32; 4] {
+) -> LevelSetup {
     let l = &c.levels[k];
     let (sx, sy) = (l.wf / c.levels[0].wf, l.hf / c.levels[0].hf);
-    if l.w == 1
+    let single = l.w == 1
         && l.h == 1
         && a.wrap.u != WrapMode::ClampToBorder
-        && a.wrap.v != WrapMode::ClampToBorder
-    {
-        return l.at(&c.lut, k as u32, 0, 0, sink);
-    }
+        && a.wrap.v != WrapMode::ClampToBorder;
     // J'·J'ᵀ in this level's texels; its trace is the sum of the squared
     // semi-axes.
     let (mut sxx, mut sxy, mut syy) = (axes.xx * sx * sx, axes.xy * sx * sy, axes.yy * sy * sy);
@@ -289,12 +379,37 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
     let ctt = syy + 1.0;
     // SPEC: A = Σtt, B = −2Σst, C = Σss, divided by F = AC − B²/4 = det Σ.
     let inv_f = 1.0 / (css * ctt - cst * cst);
-    let (qa, qb, qc) = (ctt * inv_f, -2.0 * cst * inv_f, css * inv_f);
     // Centre in texel-centre coordinates, split into an integer base and
     // a fraction so huge coordinates keep their precision.
     let (ib, fs) = split(u * l.wf - 0.5);
     let (jb, ft) = split(v * l.hf - 0.5);
-    let (fs, ft) = (fs as f64, ft as f64);
+    LevelSetup {
+        k,
+        single,
+        sigma: (css, cst, ctt),
+        q: (ctt * inv_f, -2.0 * cst * inv_f, css * inv_f),
+        base: (ib, jb),
+        frac: (fs as f64, ft as f64),
+    }
+}
+
+/// The filtered value of one level of a lookup.
+#[inline(always)]
+fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const VEC: bool>(
+    c: &Chain<P>,
+    a: &Addressing,
+    ls: &LevelSetup,
+    sink: &mut S,
+) -> [f32; 4] {
+    let k = ls.k;
+    let l = &c.levels[k];
+    if ls.single {
+        return l.at(&c.lut, k as u32, 0, 0, sink);
+    }
+    let (css, _, ctt) = ls.sigma;
+    let (qa, qb, qc) = ls.q;
+    let (ib, jb) = ls.base;
+    let (fs, ft) = ls.frac;
     // Extent in t of the ellipse r² < 1 is sqrt(Σtt).
     let t_ext = ctt.sqrt();
     let t0 = -fast_floor(t_ext - ft);
@@ -302,11 +417,63 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
     if EXACT {
         return exact_rows(l, c, k, a, (qa, qb, qc), (ib, jb), (fs, ft), (t0, t1), sink);
     }
+    #[cfg(target_arch = "x86_64")]
+    if VEC
+        && let Some(lut8) = P::packed(&c.lut)
+        && l.w as usize <= (i32::MAX / 16) as usize
+    {
+        let mut texel = |x: i64, y: i64, value: bool| {
+            if value {
+                l.fetch(&c.lut, k as u32, x, y, a, sink)
+            } else {
+                sink.texel(k as u32, x as u32, y as u32);
+                [0.0; 4]
+            }
+        };
+        let (w, h) = (l.w as usize, l.h as usize);
+        let texels = l.texels.as_ptr().cast();
+        let (qa, qb, qc) = (qa as f32, qb as f32, qc as f32);
+        let (fs, ft) = (fs as f32, ft as f32);
+        use super::ewa_simd::{Ellipse, scan};
+        #[allow(unsafe_code)]
+        // SAFETY: VEC is set only by `ewa_avx512`, run on CPUs with
+        // AVX-512 F, BW, DQ, VL and VBMI (and so POPCNT and BMI1), for
+        // 4-byte texels (`vector_texels`); `l.texels` holds the level's
+        // w·h texels, and 15·w fits an i32 (checked above).
+        let (acc, wsum) = unsafe {
+            if css >= ctt {
+                let e = Ellipse {
+                    q: (qa, qb, qc),
+                    base: (ib, jb),
+                    frac: (fs, ft),
+                    ext: ctt.sqrt(),
+                    wrap: (a.wrap.u, a.wrap.v),
+                    border: a.border,
+                };
+                scan::<false>(lut8, texels, (w, h), &e, S::TRACES, &mut texel)
+            } else {
+                let e = Ellipse {
+                    q: (qc, qb, qa),
+                    base: (jb, ib),
+                    frac: (ft, fs),
+                    ext: css.sqrt(),
+                    wrap: (a.wrap.v, a.wrap.u),
+                    border: a.border,
+                };
+                scan::<true>(lut8, texels, (w, h), &e, S::TRACES, &mut texel)
+            }
+        };
+        return if wsum > 0.0 {
+            acc.map(|x| x / wsum)
+        } else {
+            l.fetch(&c.lut, k as u32, ib, jb, a, sink)
+        };
+    }
     // Scan whichever way gives the longer runs: rows for an ellipse wider
     // than tall, columns otherwise (the per-run setup is the cost of short
     // runs; a grazing plane's ellipses run along v).
     let (acc, wsum) = if css >= ctt {
-        scan::<P, S, false, FMA, VEC>(
+        scan::<P, S, false, FMA>(
             l,
             c,
             k,
@@ -318,7 +485,7 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
             sink,
         )
     } else {
-        scan::<P, S, true, FMA, VEC>(
+        scan::<P, S, true, FMA>(
             l,
             c,
             k,
@@ -341,7 +508,7 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
 
 /// Most lines an ellipse crosses in [`scan`]: its extent across runs is
 /// at most `sqrt(MAX_RADIUS² + 1)` either side of the centre.
-const MAX_LINES: usize = 2 * (MAX_RADIUS as usize + 2) + 1;
+pub(crate) const MAX_LINES: usize = 2 * (MAX_RADIUS as usize + 2) + 1;
 
 /// `floor(x)` of a small finite `x` (|x| < 2³¹), in a form that vectorises.
 #[inline(always)]
@@ -364,7 +531,7 @@ fn floor_small<const AVX2: bool>(x: f32) -> f32 {
 /// the level are read without wrapping.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool, const VEC: bool>(
+fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool>(
     l: &super::fetch::Level<P>,
     c: &Chain<P>,
     lv: usize,
@@ -386,10 +553,6 @@ fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool, const VEC:
     let inv2a = 0.5 / qa;
     let tt0 = (t0 as f64 - ft) as f32;
     let dd = 2.0 * qa;
-    // With VEC, runs inside the level are staged for the AVX-512 sums
-    // (`lut8` is then always `Some`: `ewa` checked the texels).
-    #[cfg(target_arch = "x86_64")]
-    let (mut staged, lut8) = (super::ewa_simd::Runs::new(), P::packed(&c.lut));
     // Eight lines at a time: their runs solved together (vectorised), then
     // walked one by one.
     for base in (0..n).step_by(8) {
@@ -444,23 +607,6 @@ fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool, const VEC:
                     let (tx, ty) = if COLUMNS { (line, x) } else { (x, line) };
                     sink.texel(lv as u32, tx as u32, ty as u32);
                 };
-                #[cfg(target_arch = "x86_64")]
-                if VEC
-                    && stride <= (i32::MAX / 16) as usize
-                    && n <= 256
-                    && let Some(lut8) = lut8
-                {
-                    #[allow(unsafe_code)]
-                    // SAFETY: VEC is set only by `ewa_avx512`, run on CPUs
-                    // with AVX-512 F, BW, DQ, VL and VBMI, for 4-byte texels
-                    // (`vector_texels`); `run` holds the run's n ≤ 256
-                    // texels `stride` apart, and 15·stride fits an i32.
-                    unsafe {
-                        let first = run.as_ptr().cast();
-                        staged.push(lut8, first, stride, n, (r2, d, dd), S::TRACES, &mut hit);
-                    }
-                    continue;
-                }
                 let (t, ws) = if stride == 1 {
                     run_sum::<P, S, FMA>(run.iter(), &c.lut, (r2, d, dd), &mut hit)
                 } else {
@@ -489,13 +635,6 @@ fn scan<P: Pixel, S: TexelSink, const COLUMNS: bool, const FMA: bool, const VEC:
                 }
             }
         }
-    }
-    #[cfg(target_arch = "x86_64")]
-    if VEC && let Some(lut8) = lut8 {
-        #[allow(unsafe_code)]
-        // SAFETY: VEC is set only by `ewa_avx512` (see the push).
-        let (t, ws) = unsafe { staged.finish(lut8) };
-        return ([a0 + t[0], a1 + t[1], a2 + t[2], a3 + t[3]], wsum + ws);
     }
     ([a0, a1, a2, a3], wsum)
 }

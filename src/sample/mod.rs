@@ -760,7 +760,7 @@ impl Sampler {
                 let avx512 = self.simd.is_some();
                 #[cfg(not(target_arch = "x86_64"))]
                 let avx512 = false;
-                each(queries, out, |q| ewa::ewa(c, a, lod, o, q, sink, avx512))
+                ewa::ewa_slice(c, a, lod, o, queries, out, sink, avx512)
             }
             Kernel::Supersample => each(queries, out, |q| {
                 supersample::supersample(c, a, lod, o, q, sink)
