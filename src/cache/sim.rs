@@ -849,10 +849,10 @@ impl Simulator {
 
     /// The second level sees each missing sector run of the first as a read.
     fn fetch_l2(&mut self, line: u64, missing: u32) {
-        let Some(l2) = self.l2.as_mut() else {
+        // `new` sets the second level and its counters together.
+        let (Some(l2), Some(c)) = (self.l2.as_mut(), self.stats.l2.as_mut()) else {
             return;
         };
-        let c = self.stats.l2.as_mut().expect("l2 counters with l2");
         let mut m = missing;
         while m != 0 {
             let s = m.trailing_zeros() as u64;

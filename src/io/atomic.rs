@@ -43,46 +43,46 @@ pub fn remove_temporary_files() {
     }
 }
 
-/// A temporary file registered in [`LIVE`] while it exists.
+/// A temporary file's registration in [`LIVE`]: registered while this
+/// guard lives (from creation until renamed or deleted).
 #[derive(Debug)]
-struct Tracked(Option<NamedTempFile>);
+struct Registered(PathBuf);
 
-impl Tracked {
-    fn new(tmp: NamedTempFile) -> Self {
-        live().push(tmp.path().to_path_buf());
-        Tracked(Some(tmp))
-    }
-    fn file(&self) -> &File {
-        self.0.as_ref().expect("present until persisted").as_file()
-    }
-    fn unregister(&self) {
-        if let Some(t) = &self.0 {
-            live().retain(|p| p != t.path());
-        }
+impl Registered {
+    fn new(path: &Path) -> Self {
+        live().push(path.to_path_buf());
+        Registered(path.to_path_buf())
     }
 }
 
-impl Drop for Tracked {
+impl Drop for Registered {
     fn drop(&mut self) {
-        self.unregister();
+        live().retain(|p| *p != self.0);
     }
 }
 
 /// A fully written temporary file waiting to be renamed over `dest`.
 #[derive(Debug)]
 pub struct Staged {
-    tmp: Tracked,
+    // Declared before `tmp`, so dropping a `Staged` unregisters the
+    // temporary file before deleting it.
+    registered: Registered,
+    tmp: NamedTempFile,
     dest: PathBuf,
 }
 
 impl Staged {
     /// Rename the temporary file over the destination.
-    pub fn commit(mut self) -> Result<()> {
-        self.tmp.unregister();
-        let tmp = self.tmp.0.take().expect("present until persisted");
-        tmp.persist(&self.dest).map_err(|e| Error::Io {
-            action: format!("cannot rename into {}", self.dest.display()),
-            path: self.dest.clone(),
+    pub fn commit(self) -> Result<()> {
+        let Staged {
+            registered,
+            tmp,
+            dest,
+        } = self;
+        drop(registered);
+        tmp.persist(&dest).map_err(|e| Error::Io {
+            action: format!("cannot rename into {}", dest.display()),
+            path: dest.clone(),
             error: e.error,
         })?;
         Ok(())
@@ -143,14 +143,14 @@ where
     if let Ok(meta) = std::fs::metadata(dest) {
         let _ = tmp.as_file().set_permissions(meta.permissions());
     }
-    let tmp = Tracked::new(tmp);
+    let registered = Registered::new(tmp.path());
     let io_err = |e: std::io::Error| Error::Io {
         path: dest.to_path_buf(),
         action: format!("cannot write {}", dest.display()),
         error: e,
     };
     {
-        let mut w = BufWriter::with_capacity(1 << 20, tmp.file());
+        let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
         match catch_unwind(AssertUnwindSafe(|| write(&mut w))) {
             Ok(r) => r?,
             Err(payload) => {
@@ -162,8 +162,9 @@ where
         }
         w.flush().map_err(io_err)?;
     }
-    tmp.file().sync_all().map_err(io_err)?;
+    tmp.as_file().sync_all().map_err(io_err)?;
     Ok(Staged {
+        registered,
         tmp,
         dest: dest.to_path_buf(),
     })
@@ -245,7 +246,7 @@ mod tests {
             Ok(())
         })
         .unwrap();
-        let tmp_path = a.tmp.0.as_ref().unwrap().path().to_path_buf();
+        let tmp_path = a.tmp.path().to_path_buf();
         assert!(live().contains(&tmp_path));
         a.commit().unwrap();
         assert!(!live().contains(&tmp_path));
@@ -254,7 +255,7 @@ mod tests {
             Ok(())
         })
         .unwrap();
-        let b_tmp = b.tmp.0.as_ref().unwrap().path().to_path_buf();
+        let b_tmp = b.tmp.path().to_path_buf();
         remove_temporary_files();
         assert!(!b_tmp.exists(), "removed by the signal-handler path");
         drop(b);
