@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow, bail};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use rayon::prelude::*;
 
 use parvo::MipChain;
@@ -180,7 +180,7 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         frame: args.size,
         order: args.order,
     };
-    let bar = progress_bar(&args);
+    let bar = progress_bar(&args)?;
     let mut trace_out = match &args.trace_out {
         Some(p) => {
             let mut w = BufWriter::new(
@@ -283,13 +283,13 @@ fn load(texture: &str) -> Result<(MipChain, Option<parvo::compress::BlockFormat>
         .with_context(|| format!("cannot read texture `{texture}`"))
 }
 
-fn progress_bar(args: &CachesimArgs) -> Option<ProgressBar> {
-    (std::io::stderr().is_terminal() && !args.json).then(|| {
-        ProgressBar::new(0).with_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} {elapsed_precise}")
-                .expect("valid template"),
-        )
-    })
+fn progress_bar(args: &CachesimArgs) -> Result<Option<ProgressBar>> {
+    if !std::io::stderr().is_terminal() || args.json {
+        return Ok(None);
+    }
+    Ok(Some(
+        ProgressBar::new(0).with_style(super::bar_style(super::BAR_COUNT)?),
+    ))
 }
 
 fn trace_mode(
@@ -546,7 +546,7 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let (chain, blocks) = load(&args.texture)?;
     let total = (filters.len() * args.layouts.len() * caches.len()) as u64;
-    let bar = progress_bar(args);
+    let bar = progress_bar(args)?;
     if let Some(b) = &bar {
         b.set_length(total);
         b.set_message("configurations");

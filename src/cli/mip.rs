@@ -15,7 +15,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use clap::ValueEnum;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 
 use parvo::Wrap;
 use parvo::compress::{BlockFormat, Quality};
@@ -614,15 +614,19 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     });
     let tty = std::io::stderr().is_terminal() && !args.json;
     let batch = jobs.len() > 1;
-    let bar = tty.then(|| {
+    let bar = if tty {
         let template = if batch {
-            "{bar:40} {pos}/{len} files {elapsed_precise} {msg}"
+            super::BAR_FILES
         } else {
-            "{bar:40} {percent:>3}% {elapsed_precise} {msg}"
+            super::BAR_PERCENT
         };
-        ProgressBar::new(if batch { jobs.len() as u64 } else { 0 })
-            .with_style(ProgressStyle::with_template(template).expect("valid template"))
-    });
+        Some(
+            ProgressBar::new(if batch { jobs.len() as u64 } else { 0 })
+                .with_style(super::bar_style(template)?),
+        )
+    } else {
+        None
+    };
     let failed = Mutex::new(0usize);
     let print = Mutex::new(());
     let started = Instant::now();

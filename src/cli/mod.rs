@@ -38,6 +38,20 @@ enum Command {
     Tradeoff(Box<tradeoff::TradeoffArgs>),
 }
 
+/// Progress bar templates: a count of steps, and a percentage.
+pub(crate) const BAR_COUNT: &str = "{bar:40} {pos}/{len} {msg} {elapsed_precise}";
+/// Batches of files in `parvo mip`.
+pub(crate) const BAR_FILES: &str = "{bar:40} {pos}/{len} files {elapsed_precise} {msg}";
+/// A single file's texels in `parvo mip`.
+pub(crate) const BAR_PERCENT: &str = "{bar:40} {percent:>3}% {elapsed_precise} {msg}";
+
+/// The progress bar style of one of the templates above.
+pub(crate) fn bar_style(template: &str) -> anyhow::Result<indicatif::ProgressStyle> {
+    use anyhow::Context;
+    indicatif::ProgressStyle::with_template(template)
+        .with_context(|| format!("progress bar template `{template}`"))
+}
+
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -53,6 +67,18 @@ pub fn main() -> ExitCode {
         Err(e) => {
             eprintln!("parvo: {e:#}");
             ExitCode::from(1)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The bars are drawn only on a terminal, where no test looks: parse
+    /// every template here.
+    #[test]
+    fn progress_bar_templates_parse() {
+        for t in [super::BAR_COUNT, super::BAR_FILES, super::BAR_PERCENT] {
+            super::bar_style(t).unwrap();
         }
     }
 }
