@@ -15,6 +15,7 @@ mod float_tiff_one_two_channels_refused;
 mod hdr_clipping_unreported;
 mod info_json_silent_on_failure;
 mod ktx2_dfd_block_dimension_255_panicked;
+mod ktx2_supercompressed_levels_bypassed_max_alloc;
 mod level_template_ignores_extension;
 mod maketx_tx_read_as_one_level;
 mod multipart_and_multipage_silently_first;
