@@ -187,6 +187,8 @@ fn cache_specs_parse_and_impossible_caches_name_the_rule() {
         ("0:64:1", "at least 1"),
         ("16K:64", "SIZE:LINE:WAYS"),
         ("16K:64:4:mru", "lru, fifo or random"),
+        // 2^32 · 2^32 wrapped to 0 (a panic with overflow checks).
+        ("16K:4G:4294967296", "overflows"),
     ] {
         let e = s.parse::<CacheConfig>().unwrap_err().to_string();
         assert!(e.contains(rule), "{s}: {e}");

@@ -158,11 +158,13 @@ impl CacheConfig {
         if !self.line.is_power_of_two() {
             return bad(format!("the line size {} is not a power of two", self.line));
         }
-        if !self.size.is_multiple_of(self.line * self.ways) {
+        let Some(set_bytes) = self.line.checked_mul(self.ways) else {
+            return bad("line × ways overflows 64 bits".into());
+        };
+        if !self.size.is_multiple_of(set_bytes) {
             return bad(format!(
-                "the size {} is not a multiple of line × ways = {}",
-                self.size,
-                self.line * self.ways
+                "the size {} is not a multiple of line × ways = {set_bytes}",
+                self.size
             ));
         }
         if self.lines() > 1 << 28 {
