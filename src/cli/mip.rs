@@ -139,6 +139,9 @@ pub enum ExtArg {
     .ktx2, .dds, or a .png name containing {level} for one PNG per level (a re-run with a shorter \
     chain removes the higher levels parvo wrote before). Outputs are written \
     atomically (temporary file + rename): an error or an interrupt never leaves a truncated file.\n\n\
+    Each input is decoded within --max-width, --max-height and --max-alloc (checked from its header \
+    before allocating); docs/limits.md in the repository lists every limit, its default and how to \
+    raise it.\n\n\
     Exit codes: 0 every input succeeded; 1 some input failed (the others were written); 2 usage error."
 )]
 pub struct MipArgs {
