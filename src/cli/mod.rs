@@ -22,19 +22,16 @@ struct Cli {
     command: Command,
 }
 
+// No doc comments on the variants: clap would take them as the
+// subcommands' `about` and clear the `long_about` (exit codes, syntax,
+// limits) each `*Args` gives with its own `#[command]`.
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Build mip-mapped textures (EXR, KTX2, DDS, PNG per level).
     Mip(mip::MipArgs),
-    /// Describe a texture file: format, size, levels, tiling, metadata.
     Info(info::InfoArgs),
-    /// Sample a texture at queries read from stdin.
     Sample(sample::SampleArgs),
-    /// Simulate the texel cache: bytes from memory per layout, cache, order and filter.
     Cachesim(Box<cachesim::CachesimArgs>),
-    /// Render a scene with a filter (or the reference) to a PNG.
     Render(render::RenderArgs),
-    /// Measure each filter's speed, memory traffic, accuracy and flicker on a scene.
     Tradeoff(Box<tradeoff::TradeoffArgs>),
 }
 

@@ -26,4 +26,5 @@ mod roughness_map_ringing_went_below_zero;
 mod rounding_up_writes_invalid_ktx2;
 mod sample_ignores_recorded_wrap_modes;
 mod sat_rect_end_just_below_zero_read_a_texel_off;
+mod subcommand_long_help_hidden;
 mod tiff_associated_alpha_premultiplied_twice;
