@@ -12,7 +12,7 @@
 //!   layouts and filters, in parallel, to `DIR/sweep.csv` and an SVG plot.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, IsTerminal, Write};
+use std::io::{BufReader, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -181,13 +181,18 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         order: args.order,
     };
     let bar = progress_bar(&args)?;
-    let mut trace_out = match &args.trace_out {
+    let progress = |done: u64, total: u64| {
+        if let Some(b) = &bar {
+            b.set_length(total);
+            b.set_position(done);
+        }
+    };
+    let stats = match &args.trace_out {
+        // The trace is written while the frame is simulated, into a
+        // temporary file renamed over the destination once complete.
         Some(p) => {
-            let mut w = BufWriter::new(
-                File::create(p).with_context(|| format!("cannot create {}", p.display()))?,
-            );
-            writeln!(
-                w,
+            super::remove_temporary_files_on_interrupt();
+            let header = format!(
                 "# parvo cachesim trace: scene {} {}, texture {}, filter {}, layout {}, order {}, access bytes {}",
                 args.scene,
                 args.size,
@@ -200,33 +205,26 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
                 } else {
                     layout.texel()
                 }
-            )?;
-            Some(w)
-        }
-        None => None,
-    };
-    let mut each = |a: u64| -> parvo::Result<()> {
-        if let Some(w) = trace_out.as_mut() {
-            write_trace_line(w, unpack(a).0).map_err(|e| parvo::Error::Io {
-                path: args.trace_out.clone().unwrap_or_default(),
+            );
+            let io_err = |e: std::io::Error| parvo::Error::Io {
+                path: p.clone(),
                 action: "cannot write the trace".into(),
                 error: e,
-            })?;
+            };
+            parvo::io::atomic::write(p, |w| {
+                writeln!(w, "{header}").map_err(io_err)?;
+                setup.simulate(
+                    &l1,
+                    l2.as_ref(),
+                    &mut |a| write_trace_line(w, unpack(a).0).map_err(io_err),
+                    &progress,
+                )
+            })?
         }
-        Ok(())
+        None => setup.simulate(&l1, l2.as_ref(), &mut |_| Ok(()), &progress)?,
     };
-    let progress = |done: u64, total: u64| {
-        if let Some(b) = &bar {
-            b.set_length(total);
-            b.set_position(done);
-        }
-    };
-    let stats = setup.simulate(&l1, l2.as_ref(), &mut each, &progress)?;
     if let Some(b) = &bar {
         b.finish_and_clear();
-    }
-    if let Some(mut w) = trace_out {
-        w.flush()?;
     }
     let report = Report {
         what: format!(

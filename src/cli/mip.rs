@@ -608,13 +608,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     // Report panics (bugs in parvo or a dependency) as per-file errors, not
     // as the default multi-line message.
     std::panic::set_hook(Box::new(|_| {}));
-    // Ctrl-C: delete the temporary files being written (destinations are
-    // only ever replaced by a complete file) and exit like a shell does.
-    let _ = ctrlc::set_handler(|| {
-        io::atomic::remove_temporary_files();
-        eprintln!("parvo: interrupted; no output was left half-written");
-        std::process::exit(130);
-    });
+    super::remove_temporary_files_on_interrupt();
     let tty = std::io::stderr().is_terminal() && !args.json;
     let batch = jobs.len() > 1;
     let bar = if tty {

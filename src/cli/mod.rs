@@ -49,6 +49,16 @@ pub(crate) fn bar_style(template: &str) -> anyhow::Result<indicatif::ProgressSty
         .with_context(|| format!("progress bar template `{template}`"))
 }
 
+/// Ctrl-C: delete the temporary files being written (destinations are
+/// only ever replaced by a complete file) and exit like a shell does.
+pub(crate) fn remove_temporary_files_on_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        parvo::io::atomic::remove_temporary_files();
+        eprintln!("parvo: interrupted; no output was left half-written");
+        std::process::exit(130);
+    });
+}
+
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {

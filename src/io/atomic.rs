@@ -94,12 +94,15 @@ impl Staged {
     }
 }
 
-/// Write `dest` atomically with `write` (see the module docs).
-pub fn write<F>(dest: &Path, write: F) -> Result<()>
+/// Write `dest` atomically with `write` (see the module docs); returns
+/// what `write` returned, once the file is in place.
+pub fn write<F, T>(dest: &Path, write: F) -> Result<T>
 where
-    F: FnOnce(&mut BufWriter<&File>) -> Result<()>,
+    F: FnOnce(&mut BufWriter<&File>) -> Result<T>,
 {
-    stage(dest, write)?.commit()
+    let (staged, value) = stage_with(dest, write)?;
+    staged.commit()?;
+    Ok(value)
 }
 
 /// Write the contents of `dest` into a temporary file beside it, without
@@ -107,6 +110,14 @@ where
 pub fn stage<F>(dest: &Path, write: F) -> Result<Staged>
 where
     F: FnOnce(&mut BufWriter<&File>) -> Result<()>,
+{
+    stage_with(dest, write).map(|(staged, ())| staged)
+}
+
+/// [`stage`], keeping what `write` returned.
+fn stage_with<F, T>(dest: &Path, write: F) -> Result<(Staged, T)>
+where
+    F: FnOnce(&mut BufWriter<&File>) -> Result<T>,
 {
     if dest.is_dir() {
         return Err(Error::Io {
@@ -149,9 +160,9 @@ where
         action: format!("cannot write {}", dest.display()),
         error: e,
     };
-    {
+    let value = {
         let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
-        match catch_unwind(AssertUnwindSafe(|| write(&mut w))) {
+        let value = match catch_unwind(AssertUnwindSafe(|| write(&mut w))) {
             Ok(r) => r?,
             Err(payload) => {
                 return Err(Error::Encode {
@@ -159,15 +170,17 @@ where
                     reason: format!("encoder panicked: {}", panic_message(&*payload)),
                 });
             }
-        }
+        };
         w.flush().map_err(io_err)?;
-    }
+        value
+    };
     tmp.as_file().sync_all().map_err(io_err)?;
-    Ok(Staged {
+    let staged = Staged {
         registered,
         tmp,
         dest: dest.to_path_buf(),
-    })
+    };
+    Ok((staged, value))
 }
 
 /// Text of a panic payload (`&str` or `String`), or a placeholder.
@@ -190,12 +203,12 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let dest = dir.path().join("out.bin");
         std::fs::write(&dest, b"old").unwrap();
-        let e = write(&dest, |w| {
+        let e: Result<()> = write(&dest, |w| {
             w.write_all(b"partial").unwrap();
             Err(Error::InvalidOption("boom".into()))
         });
         assert!(e.is_err());
-        let e = write(&dest, |w| {
+        let e: Result<()> = write(&dest, |w| {
             w.write_all(b"partial").unwrap();
             panic!("dependency bug")
         });
