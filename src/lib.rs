@@ -60,6 +60,8 @@
 
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
+// No panic reachable from input: errors are values. Tests may unwrap.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod builtin;
 pub mod cache;

@@ -33,7 +33,7 @@ pub struct TextureStore {
     base: Texture,
     own_levels: Option<Vec<Texture>>,
     options: MipOptions,
-    level0: OnceLock<MipChain>,
+    level0: OnceLock<Result<MipChain, String>>,
     /// The block format the file stored its levels in, if any.
     blocks: Option<crate::compress::BlockFormat>,
     chain: OnceLock<Result<MipChain, String>>,
@@ -101,11 +101,14 @@ impl TextureStore {
         &self.base
     }
 
-    fn level0(&self) -> &MipChain {
-        self.level0.get_or_init(|| {
-            MipChain::from_levels(vec![self.base.clone()], self.options)
-                .expect("a single level always forms a chain")
-        })
+    /// Level 0 alone as a chain (made on first call; a single level
+    /// always forms a chain, but the check is `from_levels`'s).
+    fn level0(&self) -> Result<&MipChain> {
+        let r = self.level0.get_or_init(|| {
+            MipChain::from_levels(vec![self.base.clone()], self.options).map_err(|e| e.to_string())
+        });
+        r.as_ref()
+            .map_err(|e| crate::Error::InvalidOption(e.clone()))
     }
 
     /// The full mip chain (built on first call).
@@ -148,7 +151,7 @@ impl TextureStore {
         if Self::needs_mips(options) {
             self.chain()
         } else {
-            Ok(self.level0())
+            self.level0()
         }
     }
 
@@ -157,7 +160,7 @@ impl TextureStore {
     /// level-0 filters.
     pub fn sampler(&self, options: SamplerOptions) -> Result<Sampler> {
         if options.method == Method::Sat {
-            return Sampler::with_sat(self.level0(), options, self.sat(&options)?);
+            return Sampler::with_sat(self.level0()?, options, self.sat(&options)?);
         }
         Sampler::new(self.chain_for(&options)?, options)
     }
@@ -171,7 +174,7 @@ impl TextureStore {
             wrap,
             ..SamplerOptions::default()
         };
-        Sampler::new(self.level0(), o)
+        Sampler::new(self.level0()?, o)
     }
 
     /// What has been built so far.

@@ -187,6 +187,8 @@ fn cache_specs_parse_and_impossible_caches_name_the_rule() {
         ("0:64:1", "at least 1"),
         ("16K:64", "SIZE:LINE:WAYS"),
         ("16K:64:4:mru", "lru, fifo or random"),
+        // 2^32 · 2^32 wrapped to 0 (a panic with overflow checks).
+        ("16K:4G:4294967296", "overflows"),
     ] {
         let e = s.parse::<CacheConfig>().unwrap_err().to_string();
         assert!(e.contains(rule), "{s}: {e}");
@@ -240,7 +242,7 @@ fn every_layout_is_bijective_and_in_bounds() {
                 let mut sat = HashSet::new();
                 for y in [0, h / 2, h] {
                     for x in [0, w / 2, w] {
-                        let a = c.sat_address(x, y);
+                        let a = c.sat_address(x, y).unwrap();
                         assert!(a + 16 <= c.total_bytes() && c.level_of(a).is_none());
                         sat.insert(a);
                     }
@@ -265,4 +267,36 @@ fn raster_orders_visit_every_pixel_exactly_once() {
     // tiled:2 on 3x3 visits the 2x2 tile first, then the partial ones.
     let px: Vec<(u32, u32)> = RasterOrder::Tiled(2).pixels(Frame::new(3, 3)).collect();
     assert_eq!(&px[..5], &[(0, 0), (1, 0), (0, 1), (1, 1), (2, 0)]);
+}
+
+/// A `sat` sampler's table reads have no addresses in a layout of the
+/// chain alone: the run is refused, not simulated without them; the
+/// sampler's own layout lays the table out and runs.
+#[test]
+fn sat_sampler_with_a_layout_without_its_table_is_refused() {
+    use parvo::cache::run::SceneSetup;
+    use parvo::sample::{Sampler, SamplerOptions};
+    use parvo::{MipOptions, builtin, mip};
+    let chain = mip::build(
+        builtin::load("builtin:checker:64").unwrap(),
+        &MipOptions::default(),
+    )
+    .unwrap();
+    let sampler = Sampler::new(&chain, SamplerOptions::sat()).unwrap();
+    let cache: CacheConfig = "16K:64:4".parse().unwrap();
+    let without = ChainLayout::of_chain(&chain, Layout::Linear);
+    let with = ChainLayout::for_sampler(&chain, &sampler, Layout::Linear);
+    assert_eq!(without.sat_address(0, 0), None);
+    assert!(with.sat_address(0, 0).is_some());
+    for (layout, ok) in [(&without, false), (&with, true)] {
+        let setup = SceneSetup {
+            sampler: &sampler,
+            layout,
+            scene: "plane".parse().unwrap(),
+            frame: Frame::new(32, 24),
+            order: RasterOrder::Scanline,
+        };
+        let r = setup.simulate(&cache, None, &mut |_| Ok(()), &|_, _| {});
+        assert_eq!(r.is_ok(), ok, "{:?}", r.err());
+    }
 }

@@ -375,11 +375,12 @@ impl ChainLayout {
     }
 
     /// Byte address of summed-area table entry `(x, y)` (0 ≤ x ≤ w,
-    /// 0 ≤ y ≤ h); panics if no table is laid out.
+    /// 0 ≤ y ≤ h); `None` if no table is laid out (see
+    /// [`ChainLayout::with_sat`]).
     #[inline]
-    pub fn sat_address(&self, x: u32, y: u32) -> u64 {
-        let (row, entry, base) = self.sat.expect("no summed-area table in this layout");
-        base + (y as u64 * row + x as u64) * entry
+    pub fn sat_address(&self, x: u32, y: u32) -> Option<u64> {
+        let (row, entry, base) = self.sat?;
+        Some(base + (y as u64 * row + x as u64) * entry)
     }
 
     /// Which region an address belongs to: `Some(level)` for a texel of

@@ -41,6 +41,8 @@ pub fn unpack(a: u64) -> (u64, u32) {
 }
 
 /// A sink that turns texel and table-entry reads into packed addresses.
+/// Table-entry reads are recorded only when the layout has the table
+/// ([`ChainLayout::for_sampler`] lays it out for a `sat` sampler).
 pub struct AddressSink<'a> {
     layout: &'a ChainLayout,
     /// The packed accesses so far.
@@ -64,8 +66,11 @@ impl TexelSink for AddressSink<'_> {
     }
     #[inline]
     fn sat_entry(&mut self, x: u32, y: u32) {
-        self.out
-            .push(pack(self.layout.sat_address(x, y), SAT_LEVEL));
+        // A layout without the table has no address for the entry: the
+        // read is not recorded (`SceneSetup::simulate` refuses that pair).
+        if let Some(a) = self.layout.sat_address(x, y) {
+            self.out.push(pack(a, SAT_LEVEL));
+        }
     }
 }
 
@@ -122,7 +127,8 @@ impl SceneSetup<'_> {
     }
 
     /// Every access of the frame, in raster order (for sweeps, which replay
-    /// one trace under many caches).
+    /// one trace under many caches). A `sat` sampler's table reads are
+    /// missing unless the layout has the table (see [`AddressSink`]).
     pub fn record(&self) -> Trace {
         let queries = self.queries();
         let chunks: Vec<Vec<u64>> = queries
@@ -143,7 +149,9 @@ impl SceneSetup<'_> {
 
     /// Simulate the frame under `l1` (and `l2`) with sampling and
     /// simulation overlapped; `each` sees every packed access in order
-    /// (for `--trace-out`), `progress(done, total)` counts pixels.
+    /// (for `--trace-out`), `progress(done, total)` counts pixels. A `sat`
+    /// sampler needs a layout with its table
+    /// ([`ChainLayout::for_sampler`]).
     pub fn simulate(
         &self,
         l1: &CacheConfig,
@@ -151,6 +159,11 @@ impl SceneSetup<'_> {
         each: &mut dyn FnMut(u64) -> Result<()>,
         progress: &(dyn Fn(u64, u64) + Sync),
     ) -> Result<RunStats> {
+        if self.sampler.sat().is_some() && self.layout.sat_entry().is_none() {
+            return Err(Error::InvalidOption(
+                "the sampler reads a summed-area table the cache layout does not lay out".into(),
+            ));
+        }
         let queries = self.queries();
         let total = queries.len() as u64;
         let mut sim = Simulator::new(

@@ -158,11 +158,13 @@ impl CacheConfig {
         if !self.line.is_power_of_two() {
             return bad(format!("the line size {} is not a power of two", self.line));
         }
-        if !self.size.is_multiple_of(self.line * self.ways) {
+        let Some(set_bytes) = self.line.checked_mul(self.ways) else {
+            return bad("line × ways overflows 64 bits".into());
+        };
+        if !self.size.is_multiple_of(set_bytes) {
             return bad(format!(
-                "the size {} is not a multiple of line × ways = {}",
-                self.size,
-                self.line * self.ways
+                "the size {} is not a multiple of line × ways = {set_bytes}",
+                self.size
             ));
         }
         if self.lines() > 1 << 28 {
@@ -849,10 +851,10 @@ impl Simulator {
 
     /// The second level sees each missing sector run of the first as a read.
     fn fetch_l2(&mut self, line: u64, missing: u32) {
-        let Some(l2) = self.l2.as_mut() else {
+        // `new` sets the second level and its counters together.
+        let (Some(l2), Some(c)) = (self.l2.as_mut(), self.stats.l2.as_mut()) else {
             return;
         };
-        let c = self.stats.l2.as_mut().expect("l2 counters with l2");
         let mut m = missing;
         while m != 0 {
             let s = m.trailing_zeros() as u64;

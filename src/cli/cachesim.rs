@@ -12,12 +12,12 @@
 //!   layouts and filters, in parallel, to `DIR/sweep.csv` and an SVG plot.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, IsTerminal, Write};
+use std::io::{BufReader, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow, bail};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use rayon::prelude::*;
 
 use parvo::MipChain;
@@ -180,14 +180,19 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         frame: args.size,
         order: args.order,
     };
-    let bar = progress_bar(&args);
-    let mut trace_out = match &args.trace_out {
+    let bar = progress_bar(&args)?;
+    let progress = |done: u64, total: u64| {
+        if let Some(b) = &bar {
+            b.set_length(total);
+            b.set_position(done);
+        }
+    };
+    let stats = match &args.trace_out {
+        // The trace is written while the frame is simulated, into a
+        // temporary file renamed over the destination once complete.
         Some(p) => {
-            let mut w = BufWriter::new(
-                File::create(p).with_context(|| format!("cannot create {}", p.display()))?,
-            );
-            writeln!(
-                w,
+            super::remove_temporary_files_on_interrupt();
+            let header = format!(
                 "# parvo cachesim trace: scene {} {}, texture {}, filter {}, layout {}, order {}, access bytes {}",
                 args.scene,
                 args.size,
@@ -200,33 +205,26 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
                 } else {
                     layout.texel()
                 }
-            )?;
-            Some(w)
-        }
-        None => None,
-    };
-    let mut each = |a: u64| -> parvo::Result<()> {
-        if let Some(w) = trace_out.as_mut() {
-            write_trace_line(w, unpack(a).0).map_err(|e| parvo::Error::Io {
-                path: args.trace_out.clone().unwrap_or_default(),
+            );
+            let io_err = |e: std::io::Error| parvo::Error::Io {
+                path: p.clone(),
                 action: "cannot write the trace".into(),
                 error: e,
-            })?;
+            };
+            parvo::io::atomic::write(p, |w| {
+                writeln!(w, "{header}").map_err(io_err)?;
+                setup.simulate(
+                    &l1,
+                    l2.as_ref(),
+                    &mut |a| write_trace_line(w, unpack(a).0).map_err(io_err),
+                    &progress,
+                )
+            })?
         }
-        Ok(())
+        None => setup.simulate(&l1, l2.as_ref(), &mut |_| Ok(()), &progress)?,
     };
-    let progress = |done: u64, total: u64| {
-        if let Some(b) = &bar {
-            b.set_length(total);
-            b.set_position(done);
-        }
-    };
-    let stats = setup.simulate(&l1, l2.as_ref(), &mut each, &progress)?;
     if let Some(b) = &bar {
         b.finish_and_clear();
-    }
-    if let Some(mut w) = trace_out {
-        w.flush()?;
     }
     let report = Report {
         what: format!(
@@ -283,13 +281,13 @@ fn load(texture: &str) -> Result<(MipChain, Option<parvo::compress::BlockFormat>
         .with_context(|| format!("cannot read texture `{texture}`"))
 }
 
-fn progress_bar(args: &CachesimArgs) -> Option<ProgressBar> {
-    (std::io::stderr().is_terminal() && !args.json).then(|| {
-        ProgressBar::new(0).with_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} {elapsed_precise}")
-                .expect("valid template"),
-        )
-    })
+fn progress_bar(args: &CachesimArgs) -> Result<Option<ProgressBar>> {
+    if !std::io::stderr().is_terminal() || args.json {
+        return Ok(None);
+    }
+    Ok(Some(
+        ProgressBar::new(0).with_style(super::bar_style(super::BAR_COUNT)?),
+    ))
 }
 
 fn trace_mode(
@@ -546,7 +544,7 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let (chain, blocks) = load(&args.texture)?;
     let total = (filters.len() * args.layouts.len() * caches.len()) as u64;
-    let bar = progress_bar(args);
+    let bar = progress_bar(args)?;
     if let Some(b) = &bar {
         b.set_length(total);
         b.set_message("configurations");

@@ -15,7 +15,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use clap::ValueEnum;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 
 use parvo::Wrap;
 use parvo::compress::{BlockFormat, Quality};
@@ -139,6 +139,9 @@ pub enum ExtArg {
     .ktx2, .dds, or a .png name containing {level} for one PNG per level (a re-run with a shorter \
     chain removes the higher levels parvo wrote before). Outputs are written \
     atomically (temporary file + rename): an error or an interrupt never leaves a truncated file.\n\n\
+    Each input is decoded within --max-width, --max-height and --max-alloc (checked from its header \
+    before allocating); docs/limits.md in the repository lists every limit, its default and how to \
+    raise it.\n\n\
     Exit codes: 0 every input succeeded; 1 some input failed (the others were written); 2 usage error."
 )]
 pub struct MipArgs {
@@ -605,24 +608,22 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     // Report panics (bugs in parvo or a dependency) as per-file errors, not
     // as the default multi-line message.
     std::panic::set_hook(Box::new(|_| {}));
-    // Ctrl-C: delete the temporary files being written (destinations are
-    // only ever replaced by a complete file) and exit like a shell does.
-    let _ = ctrlc::set_handler(|| {
-        io::atomic::remove_temporary_files();
-        eprintln!("parvo: interrupted; no output was left half-written");
-        std::process::exit(130);
-    });
+    super::remove_temporary_files_on_interrupt();
     let tty = std::io::stderr().is_terminal() && !args.json;
     let batch = jobs.len() > 1;
-    let bar = tty.then(|| {
+    let bar = if tty {
         let template = if batch {
-            "{bar:40} {pos}/{len} files {elapsed_precise} {msg}"
+            super::BAR_FILES
         } else {
-            "{bar:40} {percent:>3}% {elapsed_precise} {msg}"
+            super::BAR_PERCENT
         };
-        ProgressBar::new(if batch { jobs.len() as u64 } else { 0 })
-            .with_style(ProgressStyle::with_template(template).expect("valid template"))
-    });
+        Some(
+            ProgressBar::new(if batch { jobs.len() as u64 } else { 0 })
+                .with_style(super::bar_style(template)?),
+        )
+    } else {
+        None
+    };
     let failed = Mutex::new(0usize);
     let print = Mutex::new(());
     let started = Instant::now();

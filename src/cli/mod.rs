@@ -22,20 +22,41 @@ struct Cli {
     command: Command,
 }
 
+// No doc comments on the variants: clap would take them as the
+// subcommands' `about` and clear the `long_about` (exit codes, syntax,
+// limits) each `*Args` gives with its own `#[command]`.
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Build mip-mapped textures (EXR, KTX2, DDS, PNG per level).
     Mip(mip::MipArgs),
-    /// Describe a texture file: format, size, levels, tiling, metadata.
     Info(info::InfoArgs),
-    /// Sample a texture at queries read from stdin.
     Sample(sample::SampleArgs),
-    /// Simulate the texel cache: bytes from memory per layout, cache, order and filter.
     Cachesim(Box<cachesim::CachesimArgs>),
-    /// Render a scene with a filter (or the reference) to a PNG.
     Render(render::RenderArgs),
-    /// Measure each filter's speed, memory traffic, accuracy and flicker on a scene.
     Tradeoff(Box<tradeoff::TradeoffArgs>),
+}
+
+/// Progress bar templates: a count of steps, and a percentage.
+pub(crate) const BAR_COUNT: &str = "{bar:40} {pos}/{len} {msg} {elapsed_precise}";
+/// Batches of files in `parvo mip`.
+pub(crate) const BAR_FILES: &str = "{bar:40} {pos}/{len} files {elapsed_precise} {msg}";
+/// A single file's texels in `parvo mip`.
+pub(crate) const BAR_PERCENT: &str = "{bar:40} {percent:>3}% {elapsed_precise} {msg}";
+
+/// The progress bar style of one of the templates above.
+pub(crate) fn bar_style(template: &str) -> anyhow::Result<indicatif::ProgressStyle> {
+    use anyhow::Context;
+    indicatif::ProgressStyle::with_template(template)
+        .with_context(|| format!("progress bar template `{template}`"))
+}
+
+/// Ctrl-C: delete the temporary files being written (destinations are
+/// only ever replaced by a complete file) and exit like a shell does.
+pub(crate) fn remove_temporary_files_on_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        parvo::io::atomic::remove_temporary_files();
+        eprintln!("parvo: interrupted; no output was left half-written");
+        std::process::exit(130);
+    });
 }
 
 pub fn main() -> ExitCode {
@@ -53,6 +74,18 @@ pub fn main() -> ExitCode {
         Err(e) => {
             eprintln!("parvo: {e:#}");
             ExitCode::from(1)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The bars are drawn only on a terminal, where no test looks: parse
+    /// every template here.
+    #[test]
+    fn progress_bar_templates_parse() {
+        for t in [super::BAR_COUNT, super::BAR_FILES, super::BAR_PERCENT] {
+            super::bar_style(t).unwrap();
         }
     }
 }

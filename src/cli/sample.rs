@@ -26,6 +26,7 @@ const CHUNK: usize = 1 << 16;
 /// Arguments of `parvo sample`.
 #[derive(clap::Args, Debug)]
 #[command(
+    about = "Sample a texture at queries read from stdin",
     long_about = "Sample a texture at queries read from stdin, one per line: \
                   `u v dudx dvdx dudy dvdy` (whitespace or comma separated, `#` comments, \
                   nan/inf accepted). Writes one line per query with one float per texture \

@@ -16,7 +16,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 
 use parvo::cache::layout::{ChainLayout, Layout};
 use parvo::cache::run::SceneSetup;
@@ -319,14 +319,13 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
     let tex = (base.width(), base.height());
     let frame = args.size;
     let tty = std::io::stderr().is_terminal();
-    let bar = tty.then(|| {
+    let bar = if tty {
         let b = ProgressBar::new(frame.height as u64 * 2 + filters.len() as u64);
-        b.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} {elapsed_precise}")
-                .expect("valid template"),
-        );
-        b
-    });
+        b.set_style(super::bar_style(super::BAR_COUNT)?);
+        Some(b)
+    } else {
+        None
+    };
     let step = |msg: &str| {
         if let Some(b) = &bar {
             b.set_message(msg.to_string());

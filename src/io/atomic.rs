@@ -43,46 +43,46 @@ pub fn remove_temporary_files() {
     }
 }
 
-/// A temporary file registered in [`LIVE`] while it exists.
+/// A temporary file's registration in [`LIVE`]: registered while this
+/// guard lives (from creation until renamed or deleted).
 #[derive(Debug)]
-struct Tracked(Option<NamedTempFile>);
+struct Registered(PathBuf);
 
-impl Tracked {
-    fn new(tmp: NamedTempFile) -> Self {
-        live().push(tmp.path().to_path_buf());
-        Tracked(Some(tmp))
-    }
-    fn file(&self) -> &File {
-        self.0.as_ref().expect("present until persisted").as_file()
-    }
-    fn unregister(&self) {
-        if let Some(t) = &self.0 {
-            live().retain(|p| p != t.path());
-        }
+impl Registered {
+    fn new(path: &Path) -> Self {
+        live().push(path.to_path_buf());
+        Registered(path.to_path_buf())
     }
 }
 
-impl Drop for Tracked {
+impl Drop for Registered {
     fn drop(&mut self) {
-        self.unregister();
+        live().retain(|p| *p != self.0);
     }
 }
 
 /// A fully written temporary file waiting to be renamed over `dest`.
 #[derive(Debug)]
 pub struct Staged {
-    tmp: Tracked,
+    // Declared before `tmp`, so dropping a `Staged` unregisters the
+    // temporary file before deleting it.
+    registered: Registered,
+    tmp: NamedTempFile,
     dest: PathBuf,
 }
 
 impl Staged {
     /// Rename the temporary file over the destination.
-    pub fn commit(mut self) -> Result<()> {
-        self.tmp.unregister();
-        let tmp = self.tmp.0.take().expect("present until persisted");
-        tmp.persist(&self.dest).map_err(|e| Error::Io {
-            action: format!("cannot rename into {}", self.dest.display()),
-            path: self.dest.clone(),
+    pub fn commit(self) -> Result<()> {
+        let Staged {
+            registered,
+            tmp,
+            dest,
+        } = self;
+        drop(registered);
+        tmp.persist(&dest).map_err(|e| Error::Io {
+            action: format!("cannot rename into {}", dest.display()),
+            path: dest.clone(),
             error: e.error,
         })?;
         Ok(())
@@ -94,12 +94,15 @@ impl Staged {
     }
 }
 
-/// Write `dest` atomically with `write` (see the module docs).
-pub fn write<F>(dest: &Path, write: F) -> Result<()>
+/// Write `dest` atomically with `write` (see the module docs); returns
+/// what `write` returned, once the file is in place.
+pub fn write<F, T>(dest: &Path, write: F) -> Result<T>
 where
-    F: FnOnce(&mut BufWriter<&File>) -> Result<()>,
+    F: FnOnce(&mut BufWriter<&File>) -> Result<T>,
 {
-    stage(dest, write)?.commit()
+    let (staged, value) = stage_with(dest, write)?;
+    staged.commit()?;
+    Ok(value)
 }
 
 /// Write the contents of `dest` into a temporary file beside it, without
@@ -107,6 +110,14 @@ where
 pub fn stage<F>(dest: &Path, write: F) -> Result<Staged>
 where
     F: FnOnce(&mut BufWriter<&File>) -> Result<()>,
+{
+    stage_with(dest, write).map(|(staged, ())| staged)
+}
+
+/// [`stage`], keeping what `write` returned.
+fn stage_with<F, T>(dest: &Path, write: F) -> Result<(Staged, T)>
+where
+    F: FnOnce(&mut BufWriter<&File>) -> Result<T>,
 {
     if dest.is_dir() {
         return Err(Error::Io {
@@ -143,15 +154,15 @@ where
     if let Ok(meta) = std::fs::metadata(dest) {
         let _ = tmp.as_file().set_permissions(meta.permissions());
     }
-    let tmp = Tracked::new(tmp);
+    let registered = Registered::new(tmp.path());
     let io_err = |e: std::io::Error| Error::Io {
         path: dest.to_path_buf(),
         action: format!("cannot write {}", dest.display()),
         error: e,
     };
-    {
-        let mut w = BufWriter::with_capacity(1 << 20, tmp.file());
-        match catch_unwind(AssertUnwindSafe(|| write(&mut w))) {
+    let value = {
+        let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file());
+        let value = match catch_unwind(AssertUnwindSafe(|| write(&mut w))) {
             Ok(r) => r?,
             Err(payload) => {
                 return Err(Error::Encode {
@@ -159,14 +170,17 @@ where
                     reason: format!("encoder panicked: {}", panic_message(&*payload)),
                 });
             }
-        }
+        };
         w.flush().map_err(io_err)?;
-    }
-    tmp.file().sync_all().map_err(io_err)?;
-    Ok(Staged {
+        value
+    };
+    tmp.as_file().sync_all().map_err(io_err)?;
+    let staged = Staged {
+        registered,
         tmp,
         dest: dest.to_path_buf(),
-    })
+    };
+    Ok((staged, value))
 }
 
 /// Text of a panic payload (`&str` or `String`), or a placeholder.
@@ -189,12 +203,12 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let dest = dir.path().join("out.bin");
         std::fs::write(&dest, b"old").unwrap();
-        let e = write(&dest, |w| {
+        let e: Result<()> = write(&dest, |w| {
             w.write_all(b"partial").unwrap();
             Err(Error::InvalidOption("boom".into()))
         });
         assert!(e.is_err());
-        let e = write(&dest, |w| {
+        let e: Result<()> = write(&dest, |w| {
             w.write_all(b"partial").unwrap();
             panic!("dependency bug")
         });
@@ -245,7 +259,7 @@ mod tests {
             Ok(())
         })
         .unwrap();
-        let tmp_path = a.tmp.0.as_ref().unwrap().path().to_path_buf();
+        let tmp_path = a.tmp.path().to_path_buf();
         assert!(live().contains(&tmp_path));
         a.commit().unwrap();
         assert!(!live().contains(&tmp_path));
@@ -254,7 +268,7 @@ mod tests {
             Ok(())
         })
         .unwrap();
-        let b_tmp = b.tmp.0.as_ref().unwrap().path().to_path_buf();
+        let b_tmp = b.tmp.path().to_path_buf();
         remove_temporary_files();
         assert!(!b_tmp.exists(), "removed by the signal-handler path");
         drop(b);

@@ -252,7 +252,10 @@ impl Header {
                 bytes.len()
             )));
         }
-        let word = |i: usize| u32::from_le_bytes(bytes[i * 4..i * 4 + 4].try_into().expect("4"));
+        // Words 0..32 are the header (length checked above), 32..37 the
+        // DX10 extension (checked before they are read).
+        let (words, _) = bytes.as_chunks::<4>();
+        let word = |i: usize| u32::from_le_bytes(words[i]);
         if &bytes[..4] != b"DDS " {
             return Err(decode_err("not a DDS file (no `DDS ` magic)"));
         }

@@ -370,8 +370,9 @@ fn sort_header_attributes(mut file: &std::fs::File) -> std::io::Result<()> {
         let type_end = cstr(&head, name_end + 1)?;
         let size_at = type_end + 1;
         let size = head
-            .get(size_at..size_at + 4)
-            .map(|b| i32::from_le_bytes(b.try_into().expect("4 bytes")))
+            .get(size_at..)
+            .and_then(|b| b.first_chunk::<4>())
+            .map(|b| i32::from_le_bytes(*b))
             .ok_or_else(|| bad("EXR header: truncated attribute"))?;
         let end =
             size_at + 4 + usize::try_from(size).map_err(|_| bad("EXR header: negative size"))?;
@@ -433,10 +434,15 @@ fn gather<T: Copy, const N: usize>(
     }
 }
 
+/// The deflate level of ZIP blocks, checked while compiling (a constant).
+const ZIP_LEVEL: libdeflater::CompressionLvl = match libdeflater::CompressionLvl::new(4) {
+    Ok(level) => level,
+    Err(_) => panic!("4 is a libdeflate level"),
+};
+
 thread_local! {
-    static DEFLATE: std::cell::RefCell<libdeflater::Compressor> = std::cell::RefCell::new(
-        libdeflater::Compressor::new(libdeflater::CompressionLvl::new(4).expect("level 4 is valid")),
-    );
+    static DEFLATE: std::cell::RefCell<libdeflater::Compressor> =
+        std::cell::RefCell::new(libdeflater::Compressor::new(ZIP_LEVEL));
 }
 
 /// OpenEXR's ZIP compression of one block: split even and odd bytes, delta

@@ -620,20 +620,51 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
         format = format.with_alpha(AlphaMode::Premultiplied);
     }
     let (w, hgt) = (h.pixel_width, h.pixel_height.max(1));
-    limits.check(w as u64, hgt as u64, bytes.len() as u64 * 2)?;
+    let size = |k: usize| crate::mip::level_size(w, hgt, k as u32, crate::mip::Rounding::Down);
+    // Bytes of level k as stored (before supercompression).
+    let stored_len = |(lw, lh): (u32, u32)| match block {
+        Some((bf, ..)) => bf.level_bytes(lw, lh),
+        None => lw as u64 * lh as u64 * format.texel_bytes() as u64,
+    };
+    // What decoding allocates, from the header alone: the decoded texels
+    // of every level, the file, and one inflated level when supercompressed
+    // (block formats decode to 4-16 times their stored bytes, and
+    // supercompressed levels can be thousands of times the file's).
+    let decoded: u64 = (0..r.levels().len())
+        .map(|k| {
+            let (lw, lh) = size(k);
+            (lw as u64 * lh as u64).saturating_mul(format.texel_bytes() as u64)
+        })
+        .fold(0, u64::saturating_add);
+    let inflated = if scheme != 0 { stored_len(size(0)) } else { 0 };
+    limits.check(
+        w as u64,
+        hgt as u64,
+        decoded
+            .saturating_add(bytes.len() as u64)
+            .saturating_add(inflated),
+    )?;
     let mut levels = Vec::new();
     for (k, level) in r.levels().enumerate() {
-        let (lw, lh) = crate::mip::level_size(w, hgt, k as u32, crate::mip::Rounding::Down);
+        let (lw, lh) = size(k);
+        let need = stored_len((lw, lh));
         let unpacked;
         let data: &[u8] = if scheme != 0 {
-            unpacked = decompress(scheme, level.data, level.uncompressed_byte_length, limits)?;
+            // The declared length is what gets allocated: it must be the
+            // level's size before anything is inflated.
+            if level.uncompressed_byte_length != need {
+                return Err(decode_err(format!(
+                    "level {k} declares {} bytes uncompressed, a {lw}x{lh} level has {need}",
+                    level.uncompressed_byte_length
+                )));
+            }
+            unpacked = decompress(scheme, level.data, need, limits)?;
             &unpacked
         } else {
             level.data
         };
         let level_tex = match block {
             Some((bf, srgb, has_alpha)) => {
-                let need = bf.level_bytes(lw, lh);
                 if data.len() as u64 != need {
                     return Err(decode_err(format!(
                         "level {k} has {} bytes, a {lw}x{lh} {bf} level needs {need}",
@@ -651,8 +682,7 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
                 crate::compress::decode(bf, srgb, alpha, lw, lh, data)?
             }
             None => {
-                let need = lw as usize * lh as usize * format.texel_bytes();
-                if data.len() != need {
+                if data.len() as u64 != need {
                     return Err(decode_err(format!(
                         "level {k} has {} bytes, {lw}x{lh} needs {need}",
                         data.len()

@@ -11,8 +11,10 @@ use crate::error::{Error, Result};
 /// Maximum width, height and allocation a decoder may use.
 ///
 /// Defaults: 65536 × 65536 texels and 4 GiB for the decoded texels (a
-/// 16384² RGBA f32 image, or a 32768² RGBA8 one). The CLI raises them with
-/// `--max-width`, `--max-height` and `--max-alloc`.
+/// 16384² RGBA f32 image, or a 32768² RGBA8 one). `parvo mip` and `parvo
+/// info` raise them with `--max-width`, `--max-height` and `--max-alloc`;
+/// docs/limits.md in the repository lists what each format counts, and
+/// every other limit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Limits {
     /// Largest accepted width in texels.

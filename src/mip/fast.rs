@@ -159,10 +159,9 @@ fn alpha_is_constant(row: &[u8], ch: usize, a: usize) -> bool {
         mask |= 0xFF << (8 * byte);
         pattern |= (row[a] as u64) << (8 * byte);
     }
-    let words = row.chunks_exact(8);
-    let rest = words.remainder();
-    let acc = words.fold(0u64, |acc, w| {
-        acc | ((u64::from_le_bytes(w.try_into().expect("8 bytes")) ^ pattern) & mask)
+    let (words, rest) = row.as_chunks::<8>();
+    let acc = words.iter().fold(0u64, |acc, w| {
+        acc | ((u64::from_le_bytes(*w) ^ pattern) & mask)
     });
     acc == 0 && rest.chunks_exact(ch).all(|px| px[a] == row[a])
 }
@@ -265,20 +264,19 @@ mod simd {
     #[target_feature(enable = "sse2")]
     fn row_rgba8(r0: &[u8], r1: &[u8], tmp: &mut [u16], dst: &mut [u8]) -> bool {
         use std::arch::x86_64::*;
-        let load =
-            |s: &[u8]| -> __m128i { bytemuck::cast(<[u8; 16]>::try_from(s).expect("16 bytes")) };
+        let load = |s: &[u8; 16]| -> __m128i { bytemuck::cast(*s) };
         let (zero, two) = (_mm_setzero_si128(), _mm_set1_epi16(2));
         let alpha_mask = _mm_set1_epi32(0xFF00_0000u32 as i32);
         let alpha_ref = _mm_set1_epi32(((r0[3] as u32) << 24) as i32);
         let mut diff = zero;
         let n = dst.len() / 16;
-        for ((d, a), b) in dst
-            .chunks_exact_mut(16)
-            .zip(r0.chunks_exact(32))
-            .zip(r1.chunks_exact(32))
-        {
-            let (a0, a1) = (load(&a[..16]), load(&a[16..]));
-            let (b0, b1) = (load(&b[..16]), load(&b[16..]));
+        // 32 source bytes (8 texels) of each row per step, as two loads.
+        fn pairs(r: &[u8]) -> &[[[u8; 16]; 2]] {
+            r.as_chunks::<16>().0.as_chunks::<2>().0
+        }
+        for ((d, [a0, a1]), [b0, b1]) in dst.chunks_exact_mut(16).zip(pairs(r0)).zip(pairs(r1)) {
+            let (a0, a1) = (load(a0), load(a1));
+            let (b0, b1) = (load(b0), load(b1));
             let any = _mm_or_si128(_mm_xor_si128(a0, alpha_ref), _mm_xor_si128(a1, alpha_ref));
             let any = _mm_or_si128(
                 any,

@@ -417,18 +417,19 @@ pub fn build_with_progress(
     };
     progress(p);
     let mut levels = Vec::with_capacity(sizes.len());
-    levels.push(base);
+    // The level the next one is reduced from, pushed once it is replaced.
+    let mut prev = base;
     for &(w, h) in &sizes[1..] {
-        let prev = levels.last().expect("level 0 is present");
-        let (next, finite) = reduce_post(prev, w, h, options, coverage0)?;
-        if deferred && levels.len() == 1 && !finite {
-            nan::check_via_reduced(&levels[0], &next)?;
+        let (next, finite) = reduce_post(&prev, w, h, options, coverage0)?;
+        if deferred && levels.is_empty() && !finite {
+            nan::check_via_reduced(&prev, &next)?;
         }
-        levels.push(next);
+        levels.push(std::mem::replace(&mut prev, next));
         p.levels_done += 1;
         p.texels_done += w as u64 * h as u64;
         progress(p);
     }
+    levels.push(prev);
     Ok(MipChain {
         levels,
         options: *options,

@@ -267,14 +267,14 @@ mod avx {
     fn vertical(rows: &[(&[f32], f32)], tmp: &mut [f32]) {
         const B: usize = 32;
         let full = tmp.len() / B * B;
-        let ld = |s: &[f32]| -> __m256 { bytemuck::cast(<[f32; 8]>::try_from(s).expect("8")) };
+        let ld = |s: &[f32; 8]| -> __m256 { bytemuck::cast(*s) };
         for (k, out) in tmp[..full].chunks_exact_mut(B).enumerate() {
             let mut acc = [_mm256_setzero_ps(); 4];
             for &(row, wt) in rows {
-                let r = &row[k * B..][..B];
+                let r: &[f32; B] = &row.as_chunks::<B>().0[k];
                 let w = _mm256_set1_ps(wt);
-                for (i, a) in acc.iter_mut().enumerate() {
-                    *a = _mm256_fmadd_ps(w, ld(&r[8 * i..8 * i + 8]), *a);
+                for (a, r8) in acc.iter_mut().zip(r.as_chunks::<8>().0) {
+                    *a = _mm256_fmadd_ps(w, ld(r8), *a);
                 }
             }
             for (o, a) in out.chunks_exact_mut(8).zip(acc) {
@@ -290,22 +290,22 @@ mod avx {
     #[target_feature(enable = "avx2,fma")]
     fn horizontal4(tmp: &[f32], dst: &mut [f32], wx: &AxisWeights, runs: &[Option<u32>]) {
         let taps = wx.taps;
-        let ld = |s: &[f32]| -> __m128 { bytemuck::cast(<[f32; 4]>::try_from(s).expect("4")) };
+        let ld = |s: &[f32; 4]| -> __m128 { bytemuck::cast(*s) };
+        let (texels, _) = tmp.as_chunks::<4>();
         for (x, d) in dst.chunks_exact_mut(4).enumerate() {
             let wgt = &wx.weight[x * taps..][..taps];
             let mut acc = _mm_setzero_ps();
             match runs[x] {
                 Some(i0) => {
-                    let s = &tmp[i0 as usize * 4..][..taps * 4];
-                    for (px, &w) in s.chunks_exact(4).zip(wgt) {
+                    let s = &texels[i0 as usize..][..taps];
+                    for (px, &w) in s.iter().zip(wgt) {
                         acc = _mm_fmadd_ps(_mm_set1_ps(w), ld(px), acc);
                     }
                 }
                 None => {
                     let idx = &wx.index[x * taps..][..taps];
                     for (&i, &w) in idx.iter().zip(wgt) {
-                        let px = &tmp[i as usize * 4..][..4];
-                        acc = _mm_fmadd_ps(_mm_set1_ps(w), ld(px), acc);
+                        acc = _mm_fmadd_ps(_mm_set1_ps(w), ld(&texels[i as usize]), acc);
                     }
                 }
             }
@@ -324,7 +324,7 @@ fn vertical(rows: &[(&[f32], f32)], tmp: &mut [f32]) {
     for (k, out) in tmp[..full].chunks_exact_mut(B).enumerate() {
         let mut acc = [0f32; B];
         for &(row, wt) in rows {
-            let r: &[f32; B] = row[k * B..][..B].try_into().expect("B values");
+            let r: &[f32; B] = &row.as_chunks::<B>().0[k];
             for i in 0..B {
                 acc[i] += wt * r[i];
             }

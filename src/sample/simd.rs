@@ -894,8 +894,7 @@ pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
         // The footprints and levels first, then the blocks: two short
         // loops overlap better than one with the whole dependent chain from
         // query to address (ρ², log2, clamps, levels, then the blocks).
-        for (b, (q8, ok)) in qc.chunks_exact(8).zip(&mut ok).enumerate() {
-            let q8: &[Query; 8] = q8.try_into().expect("8 queries");
+        for (b, (q8, ok)) in qc.as_chunks::<8>().0.iter().zip(&mut ok).enumerate() {
             let f = fields(q8);
             let (hi, lo, delta, lanes) = plans::<MIP>(lod, opts, &f);
             planned.store(8 * b, f[0], f[1], hi, lo, delta);
@@ -977,12 +976,12 @@ pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
         .zip(out.chunks_mut(super::BLOCK))
     {
         let mut st = [Setup::EMPTY; super::BLOCK];
-        let mut q8s = qs.chunks_exact(8);
-        for (q8, s) in (&mut q8s).zip(st.chunks_exact_mut(8)) {
-            setups::<MIP>(lod, opts, q8.try_into().expect("8 queries"), s);
+        let (q8s, rest) = qs.as_chunks::<8>();
+        for (q8, s) in q8s.iter().zip(st.chunks_exact_mut(8)) {
+            setups::<MIP>(lod, opts, q8, s);
         }
-        let done = qs.len() - q8s.remainder().len();
-        for (s, q) in st[done..].iter_mut().zip(q8s.remainder()) {
+        let done = qs.len() - rest.len();
+        for (s, q) in st[done..].iter_mut().zip(rest) {
             *s = aniso::setup::<Lin, MIP>(lod, opts, q);
         }
         let mut np = 0;
