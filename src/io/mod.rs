@@ -427,7 +427,47 @@ fn load_image(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loa
     let orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
     let mut il = limits.to_image();
     il.reserve(decoder.total_bytes()).map_err(lim)?;
-    let img = DynamicImage::from_decoder(decoder).map_err(lim)?;
+    let img = match decoder.color_type() {
+        // 8-bit images (the common large case) are decoded into a buffer
+        // whose pages another thread maps meanwhile (`mem::populate`):
+        // the decoder runs on one core, and first touches of a 16384²
+        // RGBA8 image cost it seconds.
+        image::ColorType::L8
+        | image::ColorType::La8
+        | image::ColorType::Rgb8
+        | image::ColorType::Rgba8 => {
+            let (w, h) = decoder.dimensions();
+            let ct = decoder.color_type();
+            let mut buf: Vec<u8> = crate::mem::zeroed(
+                usize::try_from(decoder.total_bytes())
+                    .map_err(|_| Error::Limits("image larger than memory".into()))?,
+            );
+            let (ptr, len) = (buf.as_ptr() as usize, buf.len());
+            std::thread::scope(|s| {
+                if len >= 64 << 20 {
+                    s.spawn(move || crate::mem::populate(ptr as *const u8, len));
+                }
+                decoder.read_image(&mut buf)
+            })
+            .map_err(lim)?;
+            let bad = || decode("decoded buffer does not match its size".into());
+            match ct {
+                image::ColorType::L8 => DynamicImage::ImageLuma8(
+                    image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
+                ),
+                image::ColorType::La8 => DynamicImage::ImageLumaA8(
+                    image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
+                ),
+                image::ColorType::Rgb8 => DynamicImage::ImageRgb8(
+                    image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
+                ),
+                _ => DynamicImage::ImageRgba8(
+                    image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
+                ),
+            }
+        }
+        _ => DynamicImage::from_decoder(decoder).map_err(lim)?,
+    };
     let (w, h) = (img.width(), img.height());
     let f = |ch: u8, ty: ChannelType| {
         let cs = match (file_format, png_cs) {
