@@ -1173,7 +1173,11 @@ fn build_colour(
     let base = if same {
         base
     } else {
-        match build_streamed(base, options, src, out_format, association, progress)? {
+        let base = match build_streamed(base, options, src, out_format, association, progress)? {
+            Ok(levels) => return Ok((levels, None)),
+            Err(base) => base,
+        };
+        match build_banded(base, options, src, out_format, association, progress)? {
             Ok(levels) => return Ok((levels, None)),
             Err(base) => base,
         }
@@ -1223,8 +1227,8 @@ fn build_colour(
 /// 2^4 = 16 level-0 rows: a band of 16384-wide RGBA f32 is 4 MiB).
 const STREAM_LEVELS: u32 = 4;
 
-/// The colour chain of an integer source (u8, u16) converted to another
-/// type, box filter, even-sized levels, without a full-resolution f32 copy
+/// The colour chain of a source (u8, u16, or f16/f32 without NaN or
+/// infinities) converted to another type, box filter, even-sized levels, without a full-resolution f32 copy
 /// of any level: level 0 is cut into bands of 2^m rows (m ≤ 6 levels that
 /// halve exactly: both sides divisible by 2^m, m ≤ 4), and each band, on its own
 /// thread, is decoded to linear f32, reduced through levels 1..m with the
@@ -1236,8 +1240,8 @@ const STREAM_LEVELS: u32 = 4;
 /// bit the whole-image one (`tests/mip_streamed.rs`).
 ///
 /// `Err(base)` hands the source back when the shortcut does not apply
-/// (other filters, odd sizes, alpha coverage, float sources): the caller
-/// builds whole. Memory: the source, the output chain and two threads'
+/// (other filters, odd sizes, alpha coverage, float sources holding NaN or
+/// infinities): the caller tries [`build_banded`], then builds whole. Memory: the source, the output chain and two threads'
 /// bands (about 1.4 × 16 level-0 rows of f32 each): for RGBA8 → half EXR
 /// 4 + 8 × 4/3 bytes per level-0 texel, where decoding level 0 whole held
 /// 4 + 16 + 8 × 4/3 at the end of the build.
@@ -1260,14 +1264,13 @@ fn build_streamed(
         .min(h.trailing_zeros())
         .min(STREAM_LEVELS)
         .min(sizes.len() as u32 - 1) as usize;
-    let applies = cfg!(target_endian = "little")
-        && options.filter == MipFilter::Box
+    let applies = options.filter == MipFilter::Box
         && options.fast_paths
         && options.alpha_coverage.is_none()
         && !options.normal_map
-        && matches!(src.channel_type, ChannelType::U8 | ChannelType::U16)
         && m >= 1
-        && (0..=m).all(|k| sizes[k] == ((w >> k) as u32, (h >> k) as u32));
+        && (0..=m).all(|k| sizes[k] == ((w >> k) as u32, (h >> k) as u32))
+        && bandable_source(&base, out_format);
     if !applies {
         return Ok(Err(base));
     }
@@ -1292,12 +1295,7 @@ fn build_streamed(
     // m's rows in f32 into `kept`.
     let band = |b: usize, dst: &mut [&mut [u8]], kept: &mut [f32]| -> Result<()> {
         let mut lin = vec![0f32; rows * w * ch];
-        let at = b * rows * w * ch..(b + 1) * rows * w * ch;
-        match base.texels() {
-            Texels::U8(v) => crate::texel::decode_u8(&stored, &v[at], &mut lin),
-            Texels::U16(v) => crate::texel::decode_u16(&stored, &v[at], &mut lin),
-            _ => unreachable!("integer sources only"),
-        }
+        crate::texel::decode_range_to_linear(&stored, base.texels(), b * rows * w * ch, &mut lin);
         let (mut lw, mut lr) = (w, rows);
         for (k, d) in dst.iter_mut().enumerate() {
             let t = Texture::from_f32(lw as u32, lr as u32, f32fmt, lin.clone())?;
@@ -1377,6 +1375,154 @@ fn build_streamed(
         })
     })?;
     for l in chain.into_levels().into_iter().skip(1) {
+        levels.push(convert_level(associate(l, association)?, out_format)?);
+    }
+    Ok(Ok(levels))
+}
+
+/// True for the sources the band-by-band builders take: integer texels,
+/// or float texels that are all finite and go to a float output (NaN and
+/// infinities go through the whole-image build, which applies the NaN
+/// policy to level 0 as a whole; float values written to a normalised
+/// type are counted for the clipping note there).
+fn bandable_source(base: &Texture, out: Format) -> bool {
+    cfg!(target_endian = "little")
+        && match base.channel_type() {
+            ChannelType::U8 | ChannelType::U16 => true,
+            ChannelType::F16 | ChannelType::F32 => {
+                out.channel_type.is_float() && mip::nan::check(base).is_ok()
+            }
+        }
+}
+
+/// Level-1 rows per band of [`build_banded`].
+const BAND_ROWS: usize = 16;
+
+/// The colour chain of a source converted to another type, for the
+/// filters and sizes [`build_streamed`] does not take (Kaiser, Lanczos,
+/// Mitchell, triangle; the polyphase box of odd sizes; every wrap mode),
+/// without a full-resolution f32 copy of level 0:
+/// - level 0 is decoded, alpha-associated and encoded into the output type
+///   band by band ([`BAND_ROWS`] rows per band, in parallel);
+/// - level 1 is filtered band by band ([`mip::separable::Reducer::band`]):
+///   each band decodes the level-0 rows its taps name (wrapped rows from
+///   the far edge included), so bands meet exactly;
+/// - the rest of the chain is built from level 1 in f32 as before.
+///
+/// Decoding, the filter's rows, association and encoding are the
+/// whole-image build's own, row by row, so the chain is bit for bit the
+/// whole-image one (`tests/mip_streamed.rs`). Memory: the source, the
+/// output chain and level 1 in f32 (a quarter of level 0 in f32), where
+/// the whole-image build holds level 0 in f32 too.
+///
+/// `Err(base)` hands the source back when it does not apply (alpha
+/// coverage, normal maps, a single level, a box filter the whole-image
+/// build reduces with its fast 2×2 kernel, float sources holding NaN or
+/// infinities).
+fn build_banded(
+    base: Texture,
+    options: &MipOptions,
+    src: Format,
+    out_format: Format,
+    association: Option<AlphaMode>,
+    progress: &mut dyn FnMut(mip::Progress),
+) -> Result<std::result::Result<Vec<Texture>, Texture>> {
+    let (w, h) = (base.width() as usize, base.height() as usize);
+    let sizes = mip::level_sizes(
+        base.width(),
+        base.height(),
+        options.rounding,
+        options.max_levels,
+    );
+    let fast_box = options.filter == MipFilter::Box
+        && options.fast_paths
+        && sizes
+            .get(1)
+            .is_some_and(|&(w1, h1)| 2 * w1 as usize == w && 2 * h1 as usize == h);
+    let applies = sizes.len() >= 2
+        && !fast_box
+        && options.alpha_coverage.is_none()
+        && !options.normal_map
+        && bandable_source(&base, out_format);
+    if !applies {
+        return Ok(Err(base));
+    }
+    let ch = src.channels as usize;
+    let f32fmt =
+        Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
+    let stored = base.format();
+    let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
+    let mut p = mip::Progress {
+        levels_done: 1,
+        levels_total: sizes.len() as u32,
+        texels_done: 0,
+        texels_total,
+    };
+    progress(p);
+    let decode = |j: u32, row: &mut [f32]| {
+        crate::texel::decode_range_to_linear(&stored, base.texels(), j as usize * w * ch, row)
+    };
+    // Level 0, band by band into its output buffer.
+    let out_ch = out_format.channels as usize;
+    let mut out0 = Texels::zeroed(out_format.channel_type, w * h * out_ch);
+    {
+        let bytes: &mut [u8] = match &mut out0 {
+            Texels::U8(v) => v,
+            Texels::U16(v) => bytemuck::cast_slice_mut(v),
+            Texels::F16(v) => bytemuck::cast_slice_mut(v),
+            Texels::F32(v) => bytemuck::cast_slice_mut(v),
+        };
+        let row_bytes = bytes.len() / h;
+        bytes
+            .par_chunks_mut(BAND_ROWS * row_bytes)
+            .enumerate()
+            .try_for_each(|(b, dst)| -> Result<()> {
+                let rows = dst.len() / row_bytes;
+                let mut lin = vec![0f32; rows * w * ch];
+                for (r, row) in lin.chunks_exact_mut(w * ch).enumerate() {
+                    decode((b * BAND_ROWS + r) as u32, row);
+                }
+                let t = Texture::from_f32(w as u32, rows as u32, f32fmt, lin)?;
+                let t = convert_level(associate(t, association)?, out_format)?;
+                dst.copy_from_slice(&crate::io::le_bytes(t.texels()));
+                Ok(())
+            })?;
+    }
+    let level0 = Texture::from_texels(w as u32, h as u32, out_format, out0)?;
+    // Level 1, band by band, in f32.
+    let (w1, h1) = (sizes[1].0 as usize, sizes[1].1 as usize);
+    let reducer =
+        mip::separable::Reducer::new(f32fmt, w as u32, h as u32, w1 as u32, h1 as u32, options);
+    let mut lvl1: Vec<f32> = crate::mem::zeroed(w1 * h1 * ch);
+    lvl1.par_chunks_mut(BAND_ROWS * w1 * ch)
+        .enumerate()
+        .for_each(|(b, dst)| {
+            let y0 = b * BAND_ROWS;
+            let y1 = y0 + dst.len() / (w1 * ch);
+            reducer.band(y0, y1, decode, dst);
+        });
+    drop(base);
+    p.levels_done = 2;
+    p.texels_done = (w1 * h1) as u64;
+    progress(p);
+    // The rest from level 1, in f32, as the whole-level build does.
+    let level1 = Texture::from_f32(w1 as u32, h1 as u32, f32fmt, lvl1)?;
+    let rest_options = MipOptions {
+        max_levels: Some((sizes.len() - 1) as u32),
+        ..*options
+    };
+    let done = p.texels_done;
+    let chain = mip::build_with_progress(level1, &rest_options, &mut |q| {
+        progress(mip::Progress {
+            levels_done: q.levels_done + 1,
+            levels_total: sizes.len() as u32,
+            texels_done: done + q.texels_done,
+            texels_total,
+        })
+    })?;
+    let mut levels = Vec::with_capacity(sizes.len());
+    levels.push(level0);
+    for l in chain.into_levels() {
         levels.push(convert_level(associate(l, association)?, out_format)?);
     }
     Ok(Ok(levels))

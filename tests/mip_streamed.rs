@@ -6,12 +6,19 @@
 //! (more than one 64-row band, a last partial band), straight alpha that
 //! varies (alpha-weighted boxes), sRGB and linear, u8 and u16 sources, and
 //! the outputs that convert (half EXR, premultiplied; f32 KTX2; u16 PNG).
+//!
+//! The second test holds the general band-by-band build (level 0 encoded
+//! band by band, level 1 filtered from the level-0 rows each band's taps
+//! name) to the same reference for every filter, odd sizes (the
+//! polyphase box), every wrap mode (wrapped taps reach rows of the far
+//! edge) and float sources (half and float EXR, premultiplied).
 
-use parvo::io::{self, Limits};
-use parvo::mip::{self, MipOptions};
+use parvo::io::{self, Limits, OutputKind, SaveOptions};
+use parvo::mip::{self, MipFilter, MipOptions};
 use parvo::pipeline::{self, Job, Settings};
 use parvo::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use parvo::texture::Texture;
+use parvo::wrap::Wrap;
 
 struct Rng(u64);
 impl Rng {
@@ -68,10 +75,20 @@ fn source(w: u32, h: u32, ty: ChannelType, seed: u64) -> Texture {
 
 /// The whole-image chain, as the pipeline built it before streaming.
 fn whole(base: &Texture, out: Format, premultiply: bool) -> Vec<Texture> {
+    whole_with(base, out, premultiply, &MipOptions::default())
+}
+
+/// [`whole`] with other mip options (filter, wrap).
+fn whole_with(
+    base: &Texture,
+    out: Format,
+    premultiply: bool,
+    options: &MipOptions,
+) -> Vec<Texture> {
     let f32fmt =
         Format::new(4, ChannelType::F32, ColorSpace::Linear).with_alpha(base.format().alpha);
     let lin = base.convert(f32fmt).unwrap();
-    let chain = mip::build(lin, &MipOptions::default()).unwrap();
+    let chain = mip::build(lin, options).unwrap();
     chain
         .into_levels()
         .into_iter()
@@ -151,6 +168,117 @@ fn streamed_chains_equal_whole_image_chains_bit_for_bit() {
                         g.texels() == e.texels(),
                         "{w}x{h} {ty} -> {ext}: level {k} differs"
                     );
+                }
+            }
+        }
+    }
+}
+
+/// Random RGBA floats in [0, 1.5) with alpha in [0, 1), premultiplied, as
+/// an EXR holds them.
+fn float_source(w: u32, h: u32, ty: ChannelType, seed: u64) -> Texture {
+    let mut r = Rng(seed);
+    let mut v: Vec<f32> = Vec::with_capacity((w * h * 4) as usize);
+    for _ in 0..w * h {
+        let a = (r.next() % 1000) as f32 / 1000.0;
+        for _ in 0..3 {
+            v.push((r.next() % 1500) as f32 / 1000.0 * a);
+        }
+        v.push(a);
+    }
+    let f =
+        Format::new(4, ChannelType::F32, ColorSpace::Linear).with_alpha(AlphaMode::Premultiplied);
+    let t = Texture::from_f32(w, h, f, v).unwrap();
+    t.convert(Format {
+        channel_type: ty,
+        ..f
+    })
+    .unwrap()
+}
+
+#[test]
+fn banded_chains_equal_whole_image_chains_for_every_filter_and_wrap_mode() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = 0;
+    // Odd sizes (the polyphase box), one even size for the other filters;
+    // level 1 has 33, 75 and 48 rows: bands of 16 meet inside the taps.
+    for (w, h) in [(131u32, 67u32), (37, 150), (64, 96)] {
+        for ty in [
+            ChannelType::U8,
+            ChannelType::U16,
+            ChannelType::F16,
+            ChannelType::F32,
+        ] {
+            case += 1;
+            let (input, base) = if ty.is_float() {
+                let src = float_source(w, h, ty, case);
+                let p = dir.path().join(format!("src{case}.exr"));
+                io::save(
+                    std::slice::from_ref(&src),
+                    parvo::mip::Rounding::Down,
+                    &p,
+                    OutputKind::Exr,
+                    &SaveOptions::default(),
+                )
+                .unwrap();
+                (p.to_str().unwrap().to_string(), src)
+            } else {
+                let src = source(w, h, ty, case);
+                let png = dir.path().join(format!("src{case}_{{level}}.png"));
+                io::png_levels::save(std::slice::from_ref(&src), &png).unwrap();
+                (png.to_str().unwrap().replace("{level}", "0"), src)
+            };
+            // What the pipeline reads (alpha mode, colour space).
+            let base_read = io::load(&input, &Limits::default()).unwrap().into_base();
+            assert!(base_read.texels() == base.texels());
+            let straight = base_read.format().alpha == AlphaMode::Straight;
+            for filter in MipFilter::ALL {
+                for wrap in ["repeat", "clamp", "mirror", "border"] {
+                    let wrap: Wrap = wrap.parse().unwrap();
+                    // (extension, output type, premultiplied on the way)
+                    let outs = [
+                        ("exr", ChannelType::F16, straight),
+                        ("ktx2", ChannelType::F32, false),
+                    ];
+                    for (ext, ty_out, premul) in outs {
+                        if ty_out == ty {
+                            continue; // same type: no conversion, built whole
+                        }
+                        let out = dir.path().join(format!("o{case}.{ext}"));
+                        let settings = Settings {
+                            out_type: Some(ty_out),
+                            filter,
+                            wrap: Some(wrap),
+                            ..Settings::default()
+                        };
+                        let job = Job::new(&input, &out).unwrap();
+                        pipeline::process(&job, &settings, &mut |_| {}).unwrap();
+                        let got = io::load(out.to_str().unwrap(), &Limits::default())
+                            .unwrap()
+                            .levels;
+                        let options = MipOptions {
+                            filter,
+                            wrap,
+                            ..MipOptions::default()
+                        };
+                        let want = whole_with(
+                            &base_read,
+                            Format::new(4, ty_out, ColorSpace::Linear),
+                            premul,
+                            &options,
+                        );
+                        assert_eq!(
+                            got.len(),
+                            want.len(),
+                            "{w}x{h} {ty} {filter:?} {wrap:?} -> {ext}"
+                        );
+                        for (k, (g, e)) in got.iter().zip(&want).enumerate() {
+                            assert!(
+                                g.texels() == e.texels(),
+                                "{w}x{h} {ty} {filter:?} {wrap:?} -> {ext}: level {k} differs"
+                            );
+                        }
+                    }
                 }
             }
         }

@@ -29,7 +29,7 @@ use rayon::prelude::*;
 use super::MipOptions;
 use super::weights::{self, AxisWeights};
 use crate::error::Result;
-use crate::texel::{self, AlphaMode, ChannelType, ColorSpace, Texels};
+use crate::texel::{self, AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
 /// Filtered alpha below this is treated as zero when un-weighting colour.
@@ -79,78 +79,183 @@ fn reduce_linear_checked(src: &Texture, w: u32, h: u32, options: &MipOptions) ->
     use std::sync::atomic::{AtomicBool, Ordering};
     let finite = AtomicBool::new(true);
     let fmt = src.format();
-    let ch = fmt.channels as usize;
-    let sw = src.width() as usize;
-    let wx = weights::axis(options.filter, src.width(), w, options.wrap.u);
-    // Square levels with one wrap mode share their weights (kernel
-    // evaluation is not free: Kaiser sums a Bessel series per tap).
-    let wy = if (src.height(), h, options.wrap.v) == (src.width(), w, options.wrap.u) {
-        wx.clone()
-    } else {
-        weights::axis(options.filter, src.height(), h, options.wrap.v)
-    };
-    let runs = wx.contiguous_runs();
+    let r = Reducer::new(fmt, src.width(), src.height(), w, h, options);
+    let (ch, sw) = (r.ch, r.sw);
     let data = linear_source(src);
     let data: &[f32] = &data;
     let row_of = |j: u32| &data[j as usize * sw * ch..][..sw * ch];
-    let straight = fmt
-        .alpha_channel()
-        .filter(|_| fmt.alpha == AlphaMode::Straight);
     // Per source row: Some(alpha bits) when the whole row has that alpha.
-    let row_alpha: Vec<OnceLock<Option<u32>>> = match straight {
+    let row_alpha: Vec<OnceLock<Option<u32>>> = match r.straight {
         Some(_) => (0..src.height()).map(|_| OnceLock::new()).collect(),
         None => Vec::new(),
     };
+    let alpha_of =
+        |j: u32, a: usize| *row_alpha[j as usize].get_or_init(|| one_alpha(row_of(j), ch, a));
     let row_len = w as usize * ch;
     let mut out: Vec<f32> = crate::mem::zeroed(row_len * h as usize);
     out.par_chunks_mut(row_len).enumerate().for_each_init(
         || (vec![0f32; sw * ch], Vec::<f32>::new()),
         |(tmp, scratch), (y, dst)| {
-            let taps: Vec<(u32, f32)> = wy.of(y).collect();
-            let weighted = straight.filter(|&a| {
-                let mut common = None;
-                !taps.iter().all(|&(j, _)| {
-                    let sig = *row_alpha[j as usize].get_or_init(|| one_alpha(row_of(j), ch, a));
-                    sig.is_some() && *common.get_or_insert(sig) == sig
-                })
-            });
-            match weighted {
-                None => {
-                    let rows: Vec<(&[f32], f32)> =
-                        taps.iter().map(|&(j, wt)| (row_of(j), wt)).collect();
-                    filter_row(&rows, tmp, dst, &wx, &runs, ch);
-                }
-                Some(a) => {
-                    // Premultiply the rows this destination row reads.
-                    let n = sw * ch;
-                    scratch.resize(taps.len() * n, 0.0);
-                    for (k, &(j, _)) in taps.iter().enumerate() {
-                        let pm = &mut scratch[k * n..][..n];
-                        pm.copy_from_slice(row_of(j));
-                        for t in pm.chunks_exact_mut(ch) {
-                            for c in (0..ch).filter(|&c| c != a) {
-                                t[c] *= t[a];
-                            }
-                        }
-                    }
-                    let rows: Vec<(&[f32], f32)> = taps
-                        .iter()
-                        .enumerate()
-                        .map(|(k, &(_, wt))| (&scratch[k * n..][..n], wt))
-                        .collect();
-                    filter_row(&rows, tmp, dst, &wx, &runs, ch);
-                    unpremultiply(dst, a, ch, |x| unweighted(data, sw, ch, &wx, &wy, x, y));
-                }
-            }
-            let bad = dst.iter().fold(false, |acc, v| {
-                acc | (v.to_bits() & 0x7f80_0000 == 0x7f80_0000)
-            });
-            if bad {
+            if !r.row(y, &row_of, &alpha_of, tmp, scratch, dst) {
                 finite.store(false, Ordering::Relaxed);
             }
         },
     );
     (out, finite.into_inner())
+}
+
+/// One reduction of a `sw × sh` level to `w × h` (see the module docs):
+/// the weights of both axes and what every destination row shares. Rows
+/// can be computed one by one, from any source of rows: the whole level
+/// ([`reduce`]), or bands of rows decoded as they are needed
+/// ([`Reducer::band`]); either way a row's values are the same, bit for
+/// bit.
+pub(crate) struct Reducer {
+    wx: AxisWeights,
+    wy: AxisWeights,
+    runs: Vec<Option<u32>>,
+    ch: usize,
+    sw: usize,
+    /// The straight alpha channel, if the texels have one.
+    straight: Option<usize>,
+}
+
+impl Reducer {
+    /// The reduction of a `sw × sh` level of format `fmt` (channels and
+    /// alpha mode; the values are linear f32) to `w × h`.
+    pub(crate) fn new(
+        fmt: Format,
+        sw: u32,
+        sh: u32,
+        w: u32,
+        h: u32,
+        options: &MipOptions,
+    ) -> Reducer {
+        let wx = weights::axis(options.filter, sw, w, options.wrap.u);
+        // Square levels with one wrap mode share their weights (kernel
+        // evaluation is not free: Kaiser sums a Bessel series per tap).
+        let wy = if (sh, h, options.wrap.v) == (sw, w, options.wrap.u) {
+            wx.clone()
+        } else {
+            weights::axis(options.filter, sh, h, options.wrap.v)
+        };
+        let runs = wx.contiguous_runs();
+        let straight = fmt
+            .alpha_channel()
+            .filter(|_| fmt.alpha == AlphaMode::Straight);
+        Reducer {
+            wx,
+            wy,
+            runs,
+            ch: fmt.channels as usize,
+            sw: sw as usize,
+            straight,
+        }
+    }
+
+    /// Destination row `y` into `dst` (`w · channels` values) from the
+    /// source rows `row_of(j)`; `alpha_of(j, a)` is `Some(bits)` when every
+    /// texel of source row `j` has alpha (channel `a`) with these bits.
+    /// Returns whether every value is finite.
+    fn row<'a>(
+        &self,
+        y: usize,
+        row_of: &impl Fn(u32) -> &'a [f32],
+        alpha_of: &impl Fn(u32, usize) -> Option<u32>,
+        tmp: &mut [f32],
+        scratch: &mut Vec<f32>,
+        dst: &mut [f32],
+    ) -> bool {
+        let (ch, sw) = (self.ch, self.sw);
+        let taps: Vec<(u32, f32)> = self.wy.of(y).collect();
+        let weighted = self.straight.filter(|&a| {
+            let mut common = None;
+            !taps.iter().all(|&(j, _)| {
+                let sig = alpha_of(j, a);
+                sig.is_some() && *common.get_or_insert(sig) == sig
+            })
+        });
+        match weighted {
+            None => {
+                let rows: Vec<(&[f32], f32)> =
+                    taps.iter().map(|&(j, wt)| (row_of(j), wt)).collect();
+                filter_row(&rows, tmp, dst, &self.wx, &self.runs, ch);
+            }
+            Some(a) => {
+                // Premultiply the rows this destination row reads.
+                let n = sw * ch;
+                scratch.resize(taps.len() * n, 0.0);
+                for (k, &(j, _)) in taps.iter().enumerate() {
+                    let pm = &mut scratch[k * n..][..n];
+                    pm.copy_from_slice(row_of(j));
+                    for t in pm.chunks_exact_mut(ch) {
+                        for c in (0..ch).filter(|&c| c != a) {
+                            t[c] *= t[a];
+                        }
+                    }
+                }
+                let rows: Vec<(&[f32], f32)> = taps
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &(_, wt))| (&scratch[k * n..][..n], wt))
+                    .collect();
+                filter_row(&rows, tmp, dst, &self.wx, &self.runs, ch);
+                unpremultiply(dst, a, ch, |x| {
+                    unweighted(row_of, ch, &self.wx, &self.wy, x, y)
+                });
+            }
+        }
+        !dst.iter().fold(false, |acc, v| {
+            acc | (v.to_bits() & 0x7f80_0000 == 0x7f80_0000)
+        })
+    }
+
+    /// The source rows destination rows `y0..y1` read, sorted, each once.
+    pub(crate) fn source_rows(&self, y0: usize, y1: usize) -> Vec<u32> {
+        let mut rows: Vec<u32> = (y0..y1)
+            .flat_map(|y| self.wy.of(y).map(|(j, _)| j))
+            .collect();
+        rows.sort_unstable();
+        rows.dedup();
+        rows
+    }
+
+    /// Destination rows `y0..y1` into `out` (`(y1 − y0) · w · channels`
+    /// values), from the source rows `decode(j, row)` writes (row `j` as
+    /// linear f32, `sw · channels` values); each source row the band reads
+    /// is decoded once. The rows are the ones the whole-level reduction
+    /// gives, bit for bit. Returns whether every value is finite.
+    pub(crate) fn band(
+        &self,
+        y0: usize,
+        y1: usize,
+        decode: impl Fn(u32, &mut [f32]),
+        out: &mut [f32],
+    ) -> bool {
+        let (ch, sw) = (self.ch, self.sw);
+        let n = sw * ch;
+        let rows = self.source_rows(y0, y1);
+        let mut buf = vec![0f32; rows.len() * n];
+        for (&j, dst) in rows.iter().zip(buf.chunks_exact_mut(n.max(1))) {
+            decode(j, dst);
+        }
+        let slot = |j: u32| rows.binary_search(&j).unwrap_or_default();
+        let row_of = |j: u32| &buf[slot(j) * n..][..n];
+        let alphas: Vec<Option<u32>> = match self.straight {
+            Some(a) => (0..rows.len())
+                .map(|k| one_alpha(&buf[k * n..][..n], ch, a))
+                .collect(),
+            None => Vec::new(),
+        };
+        let alpha_of = |j: u32, _: usize| alphas[slot(j)];
+        let (mut tmp, mut scratch) = (vec![0f32; n], Vec::new());
+        let row_len = out.len() / (y1 - y0).max(1);
+        let mut finite = true;
+        for (y, dst) in (y0..y1).zip(out.chunks_exact_mut(row_len.max(1))) {
+            finite &= self.row(y, &row_of, &alpha_of, &mut tmp, &mut scratch, dst);
+        }
+        finite
+    }
 }
 
 /// Divide colour by the filtered alpha; where that alpha is (near) zero
@@ -383,9 +488,8 @@ fn horizontal_n<const CH: usize>(
 
 /// Unweighted 2-D filter of one destination texel (the rare fallback for
 /// fully transparent footprints).
-fn unweighted(
-    data: &[f32],
-    sw: usize,
+fn unweighted<'a>(
+    row_of: &impl Fn(u32) -> &'a [f32],
     ch: usize,
     wx: &AxisWeights,
     wy: &AxisWeights,
@@ -394,8 +498,9 @@ fn unweighted(
 ) -> [f32; 4] {
     let mut acc = [0f32; 4];
     for (j, wj) in wy.of(y) {
+        let row = row_of(j);
         for (i, wi) in wx.of(x) {
-            let s = &data[(j as usize * sw + i as usize) * ch..][..ch];
+            let s = &row[i as usize * ch..][..ch];
             for c in 0..ch {
                 acc[c] += wi * wj * s[c];
             }

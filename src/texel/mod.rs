@@ -352,15 +352,32 @@ pub fn decode_to_linear(format: &Format, texels: &Texels, out: &mut [f32]) {
     match texels {
         Texels::U8(v) => par_zip(v, out, chunk, |i, o| decode_u8(format, i, o)),
         Texels::U16(v) => par_zip(v, out, chunk, |i, o| decode_u16(format, i, o)),
-        Texels::F16(v) => par_zip(v, out, chunk, |i, o| {
-            i.convert_to_f32_slice(o);
-            decode_float_srgb(format, o);
-        }),
-        Texels::F32(v) => par_zip(v, out, chunk, |i, o| {
-            o.copy_from_slice(i);
-            decode_float_srgb(format, o);
-        }),
+        Texels::F16(v) => par_zip(v, out, chunk, |i, o| decode_f16(format, i, o)),
+        Texels::F32(v) => par_zip(v, out, chunk, |i, o| decode_f32(format, i, o)),
     }
+}
+
+/// [`decode_to_linear`] of the values `start .. start + out.len()` only,
+/// on the calling thread: the same values, for code that decodes a band of
+/// rows at a time.
+pub fn decode_range_to_linear(format: &Format, texels: &Texels, start: usize, out: &mut [f32]) {
+    let r = start..start + out.len();
+    match texels {
+        Texels::U8(v) => decode_u8(format, &v[r], out),
+        Texels::U16(v) => decode_u16(format, &v[r], out),
+        Texels::F16(v) => decode_f16(format, &v[r], out),
+        Texels::F32(v) => decode_f32(format, &v[r], out),
+    }
+}
+
+fn decode_f16(format: &Format, i: &[f16], o: &mut [f32]) {
+    i.convert_to_f32_slice(o);
+    decode_float_srgb(format, o);
+}
+
+fn decode_f32(format: &Format, i: &[f32], o: &mut [f32]) {
+    o.copy_from_slice(i);
+    decode_float_srgb(format, o);
 }
 
 /// Encode linear-light f32 values to storage, rounding to nearest.
