@@ -142,6 +142,15 @@ pub enum ExtArg {
     Each input is decoded within --max-width, --max-height and --max-alloc (checked from its header \
     before allocating); docs/limits.md in the repository lists every limit, its default and how to \
     raise it.\n\n\
+    Memory, per level-0 texel of an input of B bytes per texel converted to an output type of O \
+    bytes per texel (the chain adds a third): box filter with sides divisible by 2, and every other \
+    filter or size, build band by band: at most B + 4/3·O, plus, for the other filters and odd \
+    sizes, level 1 in f32 (a quarter of 4 bytes per channel). RGBA8 -> half EXR: 14.7 bytes (box), \
+    18.7 (Kaiser, Lanczos, Mitchell, triangle, odd sizes). Alpha coverage, normal maps, and float \
+    inputs holding NaN/Inf or written to 8/16-bit types build whole: add level 0 in f32 (4 bytes \
+    per channel). An output of the input's own type is built in that type (the box filter without \
+    f32 copies; the other filters decode the level they reduce to f32). --stats prints the \
+    peak.\n\n\
     Exit codes: 0 every input succeeded; 1 some input failed (the others were written); 2 usage error."
 )]
 pub struct MipArgs {
