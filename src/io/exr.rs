@@ -293,10 +293,8 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
             |meta, writer| {
                 let blocks: Vec<(usize, BlockIndex)> =
                     meta.enumerate_ordered_header_block_indices().collect();
-                // Bounded batches: parallel compression, ordered writes, and
-                // never more than a batch of compressed tiles in memory.
-                for batch in blocks.chunks(512) {
-                    let chunks: Vec<::exr::error::Result<Chunk>> = batch
+                let compress = |batch: &[(usize, BlockIndex)]| -> Vec<::exr::error::Result<Chunk>> {
+                    batch
                         .par_iter()
                         .map(|(_, index)| {
                             let raw = tile_bytes(levels, index, &order);
@@ -322,10 +320,27 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
                                 .compress_to_chunk(&meta.headers)
                             }
                         })
-                        .collect();
-                    for ((index_in_header, _), chunk) in batch.iter().zip(chunks) {
-                        writer.write_chunk(*index_in_header, chunk?)?;
-                    }
+                        .collect()
+                };
+                // Bounded batches, compressed on all threads and written in
+                // order: batch k is written while batch k + 1 is being
+                // compressed, and never more than two batches of
+                // compressed tiles are in memory.
+                let mut batches = blocks.chunks(512);
+                let mut pending = batches.next().map(|b| (b, compress(b)));
+                while let Some((batch, chunks)) = pending {
+                    let next = batches.next();
+                    let (written, compressed) = rayon::join(
+                        || -> ::exr::error::UnitResult {
+                            for ((index_in_header, _), chunk) in batch.iter().zip(chunks) {
+                                writer.write_chunk(*index_in_header, chunk?)?;
+                            }
+                            Ok(())
+                        },
+                        || next.map(|b| (b, compress(b))),
+                    );
+                    written?;
+                    pending = compressed;
                 }
                 Ok(())
             },
@@ -451,7 +466,21 @@ thread_local! {
 fn zip_compress(raw: Vec<u8>) -> ::exr::error::Result<Vec<u8>> {
     let n = raw.len();
     let half = n.div_ceil(2);
-    let mut tmp = vec![0u8; n];
+    SCRATCH.with(|scratch| {
+        let mut tmp = scratch.borrow_mut();
+        tmp.resize(n, 0);
+        zip_compress_with(raw, &mut tmp[..n], half)
+    })
+}
+
+thread_local! {
+    /// The byte-split, delta-coded copy of a block, reused per thread.
+    static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// [`zip_compress`] with `tmp` (`raw.len()` bytes) as the scratch buffer.
+fn zip_compress_with(raw: Vec<u8>, tmp: &mut [u8], half: usize) -> ::exr::error::Result<Vec<u8>> {
+    let n = raw.len();
     {
         let (even, odd) = tmp.split_at_mut(half);
         let pairs = raw.chunks_exact(2);
@@ -471,7 +500,7 @@ fn zip_compress(raw: Vec<u8>) -> ::exr::error::Result<Vec<u8>> {
     let out = DEFLATE.with(|c| {
         let mut c = c.borrow_mut();
         let mut out = vec![0u8; c.zlib_compress_bound(n)];
-        c.zlib_compress(&tmp, &mut out).map(|len| {
+        c.zlib_compress(tmp, &mut out).map(|len| {
             out.truncate(len);
             out
         })
