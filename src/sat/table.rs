@@ -281,6 +281,21 @@ impl<A: Accumulator> SummedAreaTable<A> {
     /// would exceed the f32 range is refused rather than storing infinities.
     pub fn build(tex: &Texture) -> Result<Self> {
         let (w, h, ch) = (tex.width() as usize, tex.height() as usize, tex.channels());
+        // The table is reserved first, so a size the machine cannot hold
+        // is an error before any other work (not an abort while filling:
+        // an 8-bit RGBA level above 4096² needs 8 times its bytes).
+        let entries = (w + 1).checked_mul(h + 1).and_then(|n| n.checked_mul(ch));
+        let mut data: Vec<A> = Vec::new();
+        if entries.is_none_or(|n| data.try_reserve_exact(n).is_err()) {
+            let bytes =
+                (w as f64 + 1.0) * (h as f64 + 1.0) * ch as f64 * std::mem::size_of::<A>() as f64;
+            return Err(Error::Limits(format!(
+                "a summed-area table of {w}x{h} with {ch} channels in {} entries needs \
+                 {:.1} GiB, which cannot be allocated",
+                A::KIND,
+                bytes / (1u64 << 30) as f64
+            )));
+        }
         let fmt = tex.format();
         let alpha = alpha_weighting(tex);
         let kind = A::KIND;
@@ -355,7 +370,7 @@ impl<A: Accumulator> SummedAreaTable<A> {
                 sum_abs = prep.float_sums(h).0;
             }
         }
-        let data = build_bands::<A>(&prep, w, h, ch);
+        let data = build_bands::<A>(&prep, w, h, ch, data);
         if !kind.is_integer() {
             // f64 entries cannot overflow (see above) and are not rounded
             // again when stored: only f32 kinds need their largest entry.
@@ -633,9 +648,15 @@ fn border_channels(b: [f32; 4], ch: usize) -> [f32; 4] {
 /// added to a running column sum). Each entry is written once, computed in
 /// the wide type from exact (integer) or f64 running sums, so float
 /// entries are rounded once however the bands fall.
-fn build_bands<A: Accumulator>(p: &Prepared<'_>, w: usize, h: usize, ch: usize) -> Vec<A> {
+fn build_bands<A: Accumulator>(
+    p: &Prepared<'_>,
+    w: usize,
+    h: usize,
+    ch: usize,
+    mut data: Vec<A>,
+) -> Vec<A> {
     let stride = (w + 1) * ch;
-    let mut data = vec![A::default(); stride * (h + 1)];
+    data.resize(stride * (h + 1), A::default());
     let bands = (rayon::current_num_threads() * 4).clamp(1, h);
     let band_rows = h.div_ceil(bands);
     let bands = h.div_ceil(band_rows);
