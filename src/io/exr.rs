@@ -425,8 +425,8 @@ fn tile_bytes(levels: &[Texture], index: &BlockIndex, order: &[usize]) -> Vec<u8
         let end = start + bw * ch;
         for &c in order {
             match lvl.texels() {
-                Texels::F16(v) => gather(&v[start..end], ch, c, &mut raw, f16::to_le_bytes),
-                Texels::F32(v) => gather(&v[start..end], ch, c, &mut raw, f32::to_le_bytes),
+                Texels::F16(v) => gather(&v[start..end], ch, c, &mut raw, |x: f16| x.to_le_bytes()),
+                Texels::F32(v) => gather(&v[start..end], ch, c, &mut raw, |x: f32| x.to_le_bytes()),
                 _ => unreachable!("save checks for float texels"),
             }
         }
@@ -434,13 +434,14 @@ fn tile_bytes(levels: &[Texture], index: &BlockIndex, order: &[usize]) -> Vec<u8
     raw
 }
 
-/// Append channel `c` of the interleaved texels `row` as bytes.
+/// Append channel `c` of the interleaved texels `row` as little-endian
+/// bytes (`to_le_bytes`, inlined so the loop vectorises).
 fn gather<T: Copy, const N: usize>(
     row: &[T],
     ch: usize,
     c: usize,
     out: &mut Vec<u8>,
-    bytes: fn(T) -> [u8; N],
+    bytes: impl Fn(T) -> [u8; N],
 ) {
     let at = out.len();
     out.resize(at + row.len() / ch * N, 0);
@@ -467,36 +468,49 @@ fn zip_compress(raw: Vec<u8>) -> ::exr::error::Result<Vec<u8>> {
     let n = raw.len();
     let half = n.div_ceil(2);
     SCRATCH.with(|scratch| {
-        let mut tmp = scratch.borrow_mut();
-        tmp.resize(n, 0);
-        zip_compress_with(raw, &mut tmp[..n], half)
+        let (split, delta) = &mut *scratch.borrow_mut();
+        split.resize(n, 0);
+        delta.resize(n, 0);
+        zip_compress_with(raw, &mut split[..n], &mut delta[..n], half)
     })
 }
 
 thread_local! {
-    /// The byte-split, delta-coded copy of a block, reused per thread.
-    static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// The byte-split copy of a block and its delta coding, reused per
+    /// thread.
+    static SCRATCH: std::cell::RefCell<(Vec<u8>, Vec<u8>)> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
 }
 
-/// [`zip_compress`] with `tmp` (`raw.len()` bytes) as the scratch buffer.
-fn zip_compress_with(raw: Vec<u8>, tmp: &mut [u8], half: usize) -> ::exr::error::Result<Vec<u8>> {
+/// [`zip_compress`] with `split` and `delta` (`raw.len()` bytes each) as
+/// scratch buffers.
+fn zip_compress_with(
+    raw: Vec<u8>,
+    split: &mut [u8],
+    delta: &mut [u8],
+    half: usize,
+) -> ::exr::error::Result<Vec<u8>> {
     let n = raw.len();
     {
-        let (even, odd) = tmp.split_at_mut(half);
-        let pairs = raw.chunks_exact(2);
-        if let [last] = pairs.remainder() {
+        let (even, odd) = split.split_at_mut(half);
+        let (pairs, last) = raw.as_chunks::<2>();
+        if let [last] = last {
             even[half - 1] = *last;
         }
-        for ((p, e), o) in pairs.zip(even.iter_mut()).zip(odd.iter_mut()) {
-            *e = p[0];
-            *o = p[1];
+        for ((&[a, b], e), o) in pairs.iter().zip(even.iter_mut()).zip(odd.iter_mut()) {
+            *e = a;
+            *o = b;
         }
     }
-    // Delta predictor, back to front so each byte still sees its
-    // unmodified predecessor: t[i] = t[i] - t[i-1] + 128 (mod 256).
-    for i in (1..n).rev() {
-        tmp[i] = tmp[i].wrapping_sub(tmp[i - 1]).wrapping_add(128);
+    // Delta predictor: d[i] = s[i] - s[i-1] + 128 (mod 256), d[0] = s[0]
+    // (into a second buffer, so the loop vectorises).
+    if let (Some(d0), Some(&s0)) = (delta.first_mut(), split.first()) {
+        *d0 = s0;
     }
+    for (d, w) in delta[1..].iter_mut().zip(split.windows(2)) {
+        *d = w[1].wrapping_sub(w[0]).wrapping_add(128);
+    }
+    let tmp = &*delta;
     let out = DEFLATE.with(|c| {
         let mut c = c.borrow_mut();
         let mut out = vec![0u8; c.zlib_compress_bound(n)];
