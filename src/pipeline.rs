@@ -1241,8 +1241,9 @@ const STREAM_LEVELS: u32 = 4;
 ///
 /// `Err(base)` hands the source back when the shortcut does not apply
 /// (other filters, odd sizes, alpha coverage, float sources holding NaN or
-/// infinities): the caller tries [`build_banded`], then builds whole. Memory: the source, the output chain and two threads'
-/// bands (about 1.4 × 16 level-0 rows of f32 each): for RGBA8 → half EXR
+/// infinities): the caller tries [`build_banded`], then builds whole.
+/// Memory: the source, the output chain and two threads' bands (about
+/// 1.4 × 16 level-0 rows of f32 each): for RGBA8 → half EXR
 /// 4 + 8 × 4/3 bytes per level-0 texel, where decoding level 0 whole held
 /// 4 + 16 + 8 × 4/3 at the end of the build.
 fn build_streamed(

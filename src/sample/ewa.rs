@@ -435,32 +435,28 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
         let (qa, qb, qc) = (qa as f32, qb as f32, qc as f32);
         let (fs, ft) = (fs as f32, ft as f32);
         use super::ewa_simd::{Ellipse, scan};
+        // Runs down columns for an ellipse taller than wide: the roles of
+        // x and y swap.
+        let columns = css < ctt;
+        let (qa, qc) = swap(columns, (qa, qc));
+        let e = Ellipse {
+            q: (qa, qb, qc),
+            base: swap(columns, (ib, jb)),
+            frac: swap(columns, (fs, ft)),
+            ext: if columns { css } else { ctt }.sqrt(),
+            wrap: swap(columns, (a.wrap.u, a.wrap.v)),
+            border: a.border,
+        };
         #[allow(unsafe_code)]
         // SAFETY: VEC is set only by `ewa_avx512`, run on CPUs with
         // AVX-512 F, BW, DQ, VL and VBMI (and so POPCNT and BMI1), for
         // 4-byte texels (`vector_texels`); `l.texels` holds the level's
         // w·h texels, and 15·w fits an i32 (checked above).
         let (acc, wsum) = unsafe {
-            if css >= ctt {
-                let e = Ellipse {
-                    q: (qa, qb, qc),
-                    base: (ib, jb),
-                    frac: (fs, ft),
-                    ext: ctt.sqrt(),
-                    wrap: (a.wrap.u, a.wrap.v),
-                    border: a.border,
-                };
-                scan::<false>(lut8, texels, (w, h), &e, S::TRACES, &mut texel)
-            } else {
-                let e = Ellipse {
-                    q: (qc, qb, qa),
-                    base: (jb, ib),
-                    frac: (ft, fs),
-                    ext: css.sqrt(),
-                    wrap: (a.wrap.v, a.wrap.u),
-                    border: a.border,
-                };
+            if columns {
                 scan::<true>(lut8, texels, (w, h), &e, S::TRACES, &mut texel)
+            } else {
+                scan::<false>(lut8, texels, (w, h), &e, S::TRACES, &mut texel)
             }
         };
         return if wsum > 0.0 {
@@ -504,6 +500,12 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
         // centre); kept so rounding can never divide by zero.
         l.fetch(&c.lut, k as u32, ib, jb, a, sink)
     }
+}
+
+/// `(b, a)` when `yes`, else `(a, b)`.
+#[inline(always)]
+fn swap<T>(yes: bool, (a, b): (T, T)) -> (T, T) {
+    if yes { (b, a) } else { (a, b) }
 }
 
 /// Most lines an ellipse crosses in [`scan`]: its extent across runs is
