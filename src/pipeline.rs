@@ -719,6 +719,24 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         return Ok(skipped(Status::UpToDate));
     }
 
+    let save = SaveOptions {
+        // An EXR source's channel names carry to EXR output (N.X stays
+        // N.X, a lone Z stays Z); other sources get the layout's names.
+        channel_names: (src_kind == FileFormat::Exr
+            && channel_names.len() == out_format.channels as usize)
+            .then_some(channel_names),
+        wrap: options.wrap,
+        tile: s.tile,
+        compression: s.compression,
+        fingerprint: Some(fingerprint),
+        supercompression: s.supercompression,
+        attributes: vec![
+            ("parvo:filter".into(), s.filter.to_string()),
+            ("parvo:source".into(), src.to_string()),
+            ("parvo:rounding".into(), s.rounding.to_string()),
+        ],
+    };
+
     let t_build = Instant::now();
     let total_texels: u64 = level_sizes[1..]
         .iter()
@@ -739,6 +757,56 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         && src.color_space == out_format.color_space
         && association.is_none()
         && s.alpha_coverage.is_none();
+    // A box-filtered colour chain to EXR never holds level 0 in the
+    // output type: each group of its rows is built, compressed and written
+    // (`io::exr::save_streamed`), so level 0's output buffer is neither
+    // allocated nor faulted in.
+    let base = if job.kind == OutputKind::Exr
+        && s.compress.is_none()
+        && s.roughness.is_none()
+        && !s.normal_map
+        && !same
+    {
+        match Streamer::new(base, &options, src, out_format, association)? {
+            Ok(st) => match fused_group(st.band, s.tile.1 as usize) {
+                Some(group) => {
+                    let mut source = Fused {
+                        st: Some(st),
+                        group,
+                        build: std::time::Duration::ZERO,
+                        progress,
+                    };
+                    io::exr::save_streamed(
+                        width,
+                        height,
+                        out_format,
+                        s.rounding,
+                        &job.output,
+                        &save,
+                        &mut source,
+                    )?;
+                    let build_s = source.build.as_secs_f64();
+                    return Ok(Outcome {
+                        output: job.output.clone(),
+                        status: Status::Written,
+                        width,
+                        height,
+                        format: out_format,
+                        level_sizes,
+                        read_s,
+                        build_s,
+                        write_s: (t_build.elapsed().as_secs_f64() - build_s).max(0.0),
+                        notes,
+                        blocks: None,
+                    });
+                }
+                None => st.base,
+            },
+            Err(base) => base,
+        }
+    } else {
+        base
+    };
     let mut rough_levels = None;
     let levels = if let Some(r) = &s.roughness {
         let (normals, chain) =
@@ -779,23 +847,6 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     progress(Stage::Writing);
 
     let t_write = Instant::now();
-    let save = SaveOptions {
-        // An EXR source's channel names carry to EXR output (N.X stays
-        // N.X, a lone Z stays Z); other sources get the layout's names.
-        channel_names: (src_kind == FileFormat::Exr
-            && channel_names.len() == out_format.channels as usize)
-            .then_some(channel_names),
-        wrap: options.wrap,
-        tile: s.tile,
-        compression: s.compression,
-        fingerprint: Some(fingerprint),
-        supercompression: s.supercompression,
-        attributes: vec![
-            ("parvo:filter".into(), s.filter.to_string()),
-            ("parvo:source".into(), src.to_string()),
-            ("parvo:rounding".into(), s.rounding.to_string()),
-        ],
-    };
     match &blocks {
         Some((chain, _)) => io::save_blocks(chain, &job.output, job.kind, &save)?,
         None => io::save(&levels, s.rounding, &job.output, job.kind, &save)?,
@@ -1246,6 +1297,70 @@ const STREAM_LEVELS: u32 = 4;
 /// 1.4 × 16 level-0 rows of f32 each): for RGBA8 → half EXR
 /// 4 + 8 × 4/3 bytes per level-0 texel, where decoding level 0 whole held
 /// 4 + 16 + 8 × 4/3 at the end of the build.
+/// Level-0 rows per group of a fused EXR write: a multiple of both the
+/// band height and the tile height, and at least 4 bands so that the
+/// threads share each group (`None` past 256 rows: odd tile heights).
+fn fused_group(band: usize, tile_h: usize) -> Option<usize> {
+    let gcd = |mut a: usize, mut b: usize| {
+        while b != 0 {
+            (a, b) = (b, a % b);
+        }
+        a
+    };
+    let mut group = band / gcd(band, tile_h).max(1) * tile_h;
+    while group < 4 * band {
+        group *= 2;
+    }
+    (tile_h > 0 && group <= 256).then_some(group)
+}
+
+/// The band-by-band builder as the level-0 source of a streamed EXR
+/// write, timing the build and reporting progress.
+struct Fused<'a, 'p> {
+    st: Option<Streamer<'a>>,
+    group: usize,
+    build: std::time::Duration,
+    progress: &'p mut dyn FnMut(Stage),
+}
+
+impl io::exr::Level0Source for Fused<'_, '_> {
+    fn group_rows(&self) -> usize {
+        self.group
+    }
+
+    fn rows(&mut self, y0: usize, dst: &mut [u8]) -> Result<()> {
+        let t = Instant::now();
+        let st = self
+            .st
+            .as_mut()
+            .ok_or_else(|| Error::InvalidOption("level 0 asked for after the rest".into()))?;
+        st.rows(y0, dst)?;
+        let y1 = (y0 + dst.len() / (st.base.width() as usize * st.out_format.texel_bytes())) as u64;
+        let w = st.base.width() as u64;
+        let texels_done = (1..=st.m).map(|k| (w >> k) * (y1 >> k)).sum();
+        self.build += t.elapsed();
+        (self.progress)(Stage::Built { texels_done });
+        Ok(())
+    }
+
+    fn rest(&mut self) -> Result<Vec<Texture>> {
+        let t = Instant::now();
+        let st = self
+            .st
+            .take()
+            .ok_or_else(|| Error::InvalidOption("the rest of the chain asked for twice".into()))?;
+        let progress = &mut *self.progress;
+        let levels = st.finish(&mut |p: mip::Progress| {
+            progress(Stage::Built {
+                texels_done: p.texels_done,
+            })
+        })?;
+        self.build += t.elapsed();
+        (self.progress)(Stage::Writing);
+        Ok(levels)
+    }
+}
+
 fn build_streamed(
     base: Texture,
     options: &MipOptions,
@@ -1254,131 +1369,328 @@ fn build_streamed(
     association: Option<AlphaMode>,
     progress: &mut dyn FnMut(mip::Progress),
 ) -> Result<std::result::Result<Vec<Texture>, Texture>> {
-    let (w, h) = (base.width() as usize, base.height() as usize);
-    let sizes = mip::level_sizes(
-        base.width(),
-        base.height(),
-        options.rounding,
-        options.max_levels,
-    );
-    let m = (w.trailing_zeros())
-        .min(h.trailing_zeros())
-        .min(STREAM_LEVELS)
-        .min(sizes.len() as u32 - 1) as usize;
-    let applies = options.filter == MipFilter::Box
-        && options.fast_paths
-        && options.alpha_coverage.is_none()
-        && !options.normal_map
-        && m >= 1
-        && (0..=m).all(|k| sizes[k] == ((w >> k) as u32, (h >> k) as u32))
-        && bandable_source(&base, out_format);
-    if !applies {
-        return Ok(Err(base));
+    let mut st = match Streamer::new(base, options, src, out_format, association)? {
+        Ok(st) => st,
+        Err(base) => return Ok(Err(base)),
+    };
+    progress(st.progress(1, 0));
+    let (w, h) = (st.base.width(), st.base.height());
+    // Level 0 whole, as little-endian bytes written in place by the bands
+    // on all threads (zero pages from the OS: no zeroing pass).
+    let n = w as usize * h as usize * out_format.channels as usize;
+    let mut out0 = Texels::zeroed(out_format.channel_type, n);
+    st.rows(0, out0.bytes_mut())?;
+    let mut levels = vec![Texture::from_texels(w, h, out_format, out0)?];
+    levels.extend(st.finish(progress)?);
+    Ok(Ok(levels))
+}
+
+/// The state of a band-by-band box build ([`build_streamed`]): the
+/// source, levels 1..=m in the output type (filled band by band), level
+/// m's f32 rows, kept to build the rest of the chain from.
+struct Streamer<'a> {
+    base: Texture,
+    options: &'a MipOptions,
+    sizes: Vec<(u32, u32)>,
+    /// Levels made band by band after level 0.
+    m: usize,
+    /// Level-0 rows per band (2^m).
+    band: usize,
+    f32fmt: Format,
+    out_format: Format,
+    association: Option<AlphaMode>,
+    /// Levels 1..=m in the output type.
+    outs: Vec<Texels>,
+    /// Level m in linear f32.
+    keep: Vec<f32>,
+}
+
+impl<'a> Streamer<'a> {
+    /// `Err(base)` when the shortcut does not apply.
+    fn new(
+        base: Texture,
+        options: &'a MipOptions,
+        src: Format,
+        out_format: Format,
+        association: Option<AlphaMode>,
+    ) -> Result<std::result::Result<Self, Texture>> {
+        let (w, h) = (base.width() as usize, base.height() as usize);
+        let sizes = mip::level_sizes(
+            base.width(),
+            base.height(),
+            options.rounding,
+            options.max_levels,
+        );
+        let m = (w.trailing_zeros())
+            .min(h.trailing_zeros())
+            .min(STREAM_LEVELS)
+            .min(sizes.len() as u32 - 1) as usize;
+        let applies = options.filter == MipFilter::Box
+            && options.fast_paths
+            && options.alpha_coverage.is_none()
+            && !options.normal_map
+            && m >= 1
+            && (0..=m).all(|k| sizes[k] == ((w >> k) as u32, (h >> k) as u32))
+            && bandable_source(&base, out_format);
+        if !applies {
+            return Ok(Err(base));
+        }
+        let ch = src.channels as usize;
+        let out_ch = out_format.channels as usize;
+        let outs = (1..=m)
+            .map(|k| {
+                let n = sizes[k].0 as usize * sizes[k].1 as usize * out_ch;
+                Texels::zeroed(out_format.channel_type, n)
+            })
+            .collect();
+        let keep = crate::mem::zeroed(sizes[m].0 as usize * sizes[m].1 as usize * ch);
+        Ok(Ok(Streamer {
+            base,
+            options,
+            sizes,
+            m,
+            band: 1 << m,
+            f32fmt: Format::new(src.channels, ChannelType::F32, ColorSpace::Linear)
+                .with_alpha(src.alpha),
+            out_format,
+            association,
+            outs,
+            keep,
+        }))
     }
-    let ch = src.channels as usize;
-    let f32fmt =
-        Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
-    let straight = f32fmt
-        .alpha_channel()
-        .filter(|_| f32fmt.alpha == AlphaMode::Straight);
-    let stored = base.format();
-    let rows = 1usize << m;
-    let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
-    let mut p = mip::Progress {
-        levels_done: 1,
-        levels_total: sizes.len() as u32,
-        texels_done: 0,
-        texels_total,
-    };
-    progress(p);
-    // One band: level-0 rows [b·rows, (b+1)·rows) → the band's rows of
-    // levels 0..=m in the output type, written into `dst[k]`, and level
-    // m's rows in f32 into `kept`.
-    let band = |b: usize, dst: &mut [&mut [u8]], kept: &mut [f32]| -> Result<()> {
-        let mut lin = vec![0f32; rows * w * ch];
-        crate::texel::decode_range_to_linear(&stored, base.texels(), b * rows * w * ch, &mut lin);
-        let (mut lw, mut lr) = (w, rows);
-        for (k, d) in dst.iter_mut().enumerate() {
-            let t = Texture::from_f32(lw as u32, lr as u32, f32fmt, lin.clone())?;
-            let t = convert_level(associate(t, association)?, out_format)?;
-            d.copy_from_slice(&crate::io::le_bytes(t.texels()));
-            if k == m {
-                kept.copy_from_slice(&lin);
-                break;
-            }
-            let (nw, nr) = (lw / 2, lr / 2);
-            let mut next = vec![0f32; nw * nr * ch];
-            for (r, o) in next.chunks_exact_mut(nw * ch).enumerate() {
-                let r0 = &lin[2 * r * lw * ch..(2 * r + 1) * lw * ch];
-                let r1 = &lin[(2 * r + 1) * lw * ch..(2 * r + 2) * lw * ch];
-                mip::fast::box_row_f32(r0, r1, o, ch, straight);
-            }
-            (lw, lr, lin) = (nw, nr, next);
+
+    fn progress(&self, levels_done: u32, texels_done: u64) -> mip::Progress {
+        mip::Progress {
+            levels_done,
+            levels_total: self.sizes.len() as u32,
+            texels_done,
+            texels_total: self.sizes[1..]
+                .iter()
+                .map(|&(w, h)| w as u64 * h as u64)
+                .sum(),
         }
-        Ok(())
-    };
-    // Every level's buffer, as little-endian bytes written in place by the
-    // bands on all threads (zero pages from the OS: no zeroing pass).
-    let out_ch = out_format.channels as usize;
-    let nbands = h / rows;
-    let mut outs: Vec<Texels> = (0..=m)
-        .map(|k| {
-            let n = sizes[k].0 as usize * sizes[k].1 as usize * out_ch;
-            Texels::zeroed(out_format.channel_type, n)
-        })
-        .collect();
-    let mut keep: Vec<f32> = crate::mem::zeroed(sizes[m].0 as usize * sizes[m].1 as usize * ch);
-    {
-        let mut lists: Vec<Vec<&mut [u8]>> =
-            (0..nbands).map(|_| Vec::with_capacity(m + 1)).collect();
-        for o in outs.iter_mut() {
-            // The typed buffer as bytes (little-endian host: the bytes
-            // `le_bytes` gives are the values' own).
-            let bytes: &mut [u8] = match o {
-                Texels::U8(v) => v,
-                Texels::U16(v) => bytemuck::cast_slice_mut(v),
-                Texels::F16(v) => bytemuck::cast_slice_mut(v),
-                Texels::F32(v) => bytemuck::cast_slice_mut(v),
-            };
-            let per = bytes.len() / nbands;
-            for (b, c) in bytes.chunks_mut(per).enumerate() {
-                lists[b].push(c);
+    }
+
+    /// Level-0 rows `y0 ..` (as many as `dst0` holds, a multiple of the
+    /// band height from a multiple of it) encoded into `dst0` as
+    /// little-endian bytes of the output type, and the rows of levels
+    /// 1..=m that come from them, in parallel over bands.
+    fn rows(&mut self, y0: usize, dst0: &mut [u8]) -> Result<()> {
+        let Streamer {
+            base,
+            m,
+            band: rows,
+            f32fmt,
+            out_format,
+            association,
+            outs,
+            keep,
+            ..
+        } = self;
+        let (m, rows, f32fmt, out_format, association) =
+            (*m, *rows, *f32fmt, *out_format, *association);
+        let w = base.width() as usize;
+        let ch = f32fmt.channels as usize;
+        let tb = out_format.texel_bytes();
+        let per0 = rows * w * tb;
+        if !y0.is_multiple_of(rows) || !dst0.len().is_multiple_of(per0) {
+            return Err(Error::InvalidOption(format!(
+                "level-0 rows from {y0} in {} bytes are not whole bands of {rows} rows",
+                dst0.len()
+            )));
+        }
+        let (b0, nb) = (y0 / rows, dst0.len() / per0);
+        let mut lists: Vec<Vec<&mut [u8]>> = dst0.chunks_mut(per0).map(|c| vec![c]).collect();
+        for (k, o) in outs.iter_mut().enumerate() {
+            let per = (w >> (k + 1)) * (rows >> (k + 1)) * tb;
+            let bytes = o.bytes_mut();
+            for (l, c) in lists
+                .iter_mut()
+                .zip(bytes[b0 * per..(b0 + nb) * per].chunks_mut(per))
+            {
+                l.push(c);
             }
         }
-        let per_keep = keep.len() / nbands;
+        let per_keep = (w >> m) * (rows >> m) * ch;
+        let kept = &mut keep[b0 * per_keep..(b0 + nb) * per_keep];
+        let straight = f32fmt
+            .alpha_channel()
+            .filter(|_| f32fmt.alpha == AlphaMode::Straight);
+        let stored = base.format();
+        let texels = base.texels();
+        // Per-thread scratch: level k's band rows in f32 and level k + 1's,
+        // reused from band to band (fresh buffers per band cost a page
+        // fault per 4 KiB each time the allocator hands memory back).
+        let band_len = rows * w * ch;
+        let scratch = || {
+            (
+                Vec::<f32>::with_capacity(band_len),
+                Vec::<f32>::with_capacity(band_len / 4),
+            )
+        };
+        let band = |(cur, next): &mut (Vec<f32>, Vec<f32>),
+                    b: usize,
+                    dst: &mut [&mut [u8]],
+                    kept: &mut [f32]|
+         -> Result<()> {
+            cur.resize(band_len, 0.0);
+            crate::texel::decode_range_to_linear(&stored, texels, b * band_len, cur);
+            let (mut lw, mut lr) = (w, rows);
+            for (k, d) in dst.iter_mut().enumerate() {
+                encode_band(cur, lw, lr, f32fmt, association, out_format, d)?;
+                if k == m {
+                    kept.copy_from_slice(cur);
+                    break;
+                }
+                let (nw, nr) = (lw / 2, lr / 2);
+                next.resize(nw * nr * ch, 0.0);
+                for (r, o) in next.chunks_exact_mut(nw * ch).enumerate() {
+                    let r0 = &cur[2 * r * lw * ch..(2 * r + 1) * lw * ch];
+                    let r1 = &cur[(2 * r + 1) * lw * ch..(2 * r + 2) * lw * ch];
+                    mip::fast::box_row_f32(r0, r1, o, ch, straight);
+                }
+                std::mem::swap(cur, next);
+                (lw, lr) = (nw, nr);
+            }
+            Ok(())
+        };
         lists
             .into_par_iter()
-            .zip(keep.par_chunks_mut(per_keep))
+            .zip(kept.par_chunks_mut(per_keep))
             .enumerate()
-            .try_for_each(|(b, (mut l, kp))| band(b, &mut l, kp))?;
+            .try_for_each_init(scratch, |sc, (i, (mut l, kp))| band(sc, b0 + i, &mut l, kp))
     }
-    drop(base);
-    let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len());
-    for (k, t) in outs.into_iter().enumerate() {
-        levels.push(Texture::from_texels(sizes[k].0, sizes[k].1, out_format, t)?);
-    }
-    p.levels_done = m as u32 + 1;
-    p.texels_done = sizes[1..=m].iter().map(|&(w, h)| w as u64 * h as u64).sum();
-    progress(p);
-    // The rest from level m, in f32, as the whole-level build does.
-    let level_m = Texture::from_f32(sizes[m].0, sizes[m].1, f32fmt, keep)?;
-    let rest_options = MipOptions {
-        max_levels: Some((sizes.len() - m) as u32),
-        ..*options
-    };
-    let done = p.texels_done;
-    let chain = mip::build_with_progress(level_m, &rest_options, &mut |q| {
+
+    /// Levels 1.. once every row of level 0 went through [`Self::rows`]:
+    /// levels 1..=m from the bands, the rest built from level m in f32,
+    /// as the whole-level build does.
+    fn finish(self, progress: &mut dyn FnMut(mip::Progress)) -> Result<Vec<Texture>> {
+        let Streamer {
+            base,
+            options,
+            sizes,
+            m,
+            f32fmt,
+            out_format,
+            association,
+            outs,
+            keep,
+            ..
+        } = self;
+        drop(base);
+        let done: u64 = sizes[1..=m].iter().map(|&(w, h)| w as u64 * h as u64).sum();
+        let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
         progress(mip::Progress {
-            levels_done: q.levels_done + m as u32,
+            levels_done: m as u32 + 1,
             levels_total: sizes.len() as u32,
-            texels_done: done + q.texels_done,
+            texels_done: done,
             texels_total,
-        })
-    })?;
-    for l in chain.into_levels().into_iter().skip(1) {
-        levels.push(convert_level(associate(l, association)?, out_format)?);
+        });
+        let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len() - 1);
+        for (k, t) in outs.into_iter().enumerate() {
+            levels.push(Texture::from_texels(
+                sizes[k + 1].0,
+                sizes[k + 1].1,
+                out_format,
+                t,
+            )?);
+        }
+        let level_m = Texture::from_f32(sizes[m].0, sizes[m].1, f32fmt, keep)?;
+        let rest_options = MipOptions {
+            max_levels: Some((sizes.len() - m) as u32),
+            ..*options
+        };
+        let chain = mip::build_with_progress(level_m, &rest_options, &mut |q| {
+            progress(mip::Progress {
+                levels_done: q.levels_done + m as u32,
+                levels_total: sizes.len() as u32,
+                texels_done: done + q.texels_done,
+                texels_total,
+            })
+        })?;
+        for l in chain.into_levels().into_iter().skip(1) {
+            levels.push(convert_level(associate(l, association)?, out_format)?);
+        }
+        Ok(levels)
     }
-    Ok(Ok(levels))
+}
+
+/// One band of a level (`lw`×`lr` texels of linear f32 in `fmt`) with
+/// its alpha association changed and encoded into `out` as little-endian
+/// bytes in `dst`: the same values as [`associate`] then [`convert_level`]
+/// give for the whole level. Linear float outputs of the same channels
+/// (the EXR path) are encoded a few texels at a time with no allocation;
+/// other outputs go through the whole-level functions.
+fn encode_band(
+    lin: &[f32],
+    lw: usize,
+    lr: usize,
+    fmt: Format,
+    association: Option<AlphaMode>,
+    out: Format,
+    dst: &mut [u8],
+) -> Result<()> {
+    let ch = fmt.channels as usize;
+    let direct = out.channels == fmt.channels
+        && out.color_space == ColorSpace::Linear
+        && fmt.color_space == ColorSpace::Linear
+        && matches!(out.channel_type, ChannelType::F16 | ChannelType::F32)
+        && cfg!(target_endian = "little");
+    if !direct {
+        let t = Texture::from_f32(lw as u32, lr as u32, fmt, lin.to_vec())?;
+        let t = convert_level(associate(t, association)?, out)?;
+        dst.copy_from_slice(&crate::io::le_bytes(t.texels()));
+        return Ok(());
+    }
+    const STEP: usize = 256;
+    let mut tmp = [0f32; STEP * 4];
+    let bytes = out.channel_type.bytes();
+    for (i, o) in lin.chunks(STEP * ch).zip(dst.chunks_mut(STEP * ch * bytes)) {
+        let t = &mut tmp[..i.len()];
+        t.copy_from_slice(i);
+        match association {
+            Some(AlphaMode::Premultiplied) => {
+                for px in t.chunks_exact_mut(ch) {
+                    let a = px[ch - 1];
+                    px[..ch - 1].iter_mut().for_each(|c| *c *= a);
+                }
+            }
+            Some(_) => {
+                for px in t.chunks_exact_mut(ch) {
+                    let a = px[ch - 1];
+                    if a != 0.0 {
+                        px[..ch - 1].iter_mut().for_each(|c| *c /= a);
+                    }
+                }
+            }
+            None => {}
+        }
+        match out.channel_type {
+            ChannelType::F16 => {
+                use half::slice::{HalfBitsSliceExt, HalfFloatSliceExt};
+                let o: &mut [half::f16] =
+                    bytemuck::cast_slice_mut::<u8, u16>(o).reinterpret_cast_mut();
+                o.convert_from_f32_slice(t);
+                saturate_f16(t, o);
+            }
+            _ => o.copy_from_slice(bytemuck::cast_slice(t)),
+        }
+    }
+    Ok(())
+}
+
+/// Finite values that became infinite in f16 saturate to ±65504, as
+/// [`crate::texel::encode_from_linear`] does.
+fn saturate_f16(from: &[f32], to: &mut [half::f16]) {
+    for (o, &i) in to.iter_mut().zip(from) {
+        if i.is_finite() && o.is_infinite() {
+            *o = if i > 0.0 {
+                half::f16::MAX
+            } else {
+                half::f16::MIN
+            };
+        }
+    }
 }
 
 /// True for the sources the band-by-band builders take: integer texels,
@@ -1616,15 +1928,7 @@ fn f32_to_f16(l: &Texture, f: Format) -> Result<Texture> {
         .zip(v.par_chunks(1 << 16))
         .for_each(|(o, i)| {
             o.convert_from_f32_slice(i);
-            for (o, &i) in o.iter_mut().zip(i) {
-                if i.is_finite() && o.is_infinite() {
-                    *o = if i > 0.0 {
-                        half::f16::MAX
-                    } else {
-                        half::f16::MIN
-                    };
-                }
-            }
+            saturate_f16(i, o);
         });
     Texture::from_f16(l.width(), l.height(), f, out)
 }

@@ -24,6 +24,10 @@ fn one_and_two_threads_write_the_same_bytes() {
         // Odd size: partial tiles, odd levels; kaiser reads across bands.
         ("builtin:photo:333", "exr", vec!["--filter", "kaiser"]),
         ("builtin:photo:333", "exr", vec!["--compression", "piz"]),
+        // Even size, box: level 0 built, compressed and written a group of
+        // rows at a time (the fused EXR path), with a tile height that is
+        // not the group's.
+        ("builtin:photo:512", "exr", vec!["--tile", "32x16"]),
         ("builtin:checker:300", "ktx2", vec!["--zstd", "5"]),
         ("builtin:zoneplate:257", "dds", vec![]),
         ("builtin:photo:129", "png", vec!["--filter", "lanczos3"]),

@@ -195,11 +195,133 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
             levels.len()
         )));
     }
+    let (header, tiles) = plan(w, h, first.format(), levels.len() > 1, rounding, opts)?;
+    write_file(path, header, |meta, writer| {
+        let blocks: Vec<(usize, BlockIndex)> =
+            meta.enumerate_ordered_header_block_indices().collect();
+        write_blocks(writer, &blocks, |index| {
+            tiles.chunk(&levels[index.level.x()], 0, index, &meta.headers)
+        })
+    })
+}
+
+/// Where level 0 of a streamed EXR write ([`save_streamed`]) comes from:
+/// its rows, a group at a time and in order, then the other levels.
+pub trait Level0Source {
+    /// Level-0 rows per call of [`Level0Source::rows`] (the last group
+    /// may be shorter); a multiple of the tile height.
+    fn group_rows(&self) -> usize;
+    /// Level-0 rows `y0 .. y0 + n` as little-endian texels of the
+    /// output format, `n` = `dst.len()` / (width · texel bytes).
+    fn rows(&mut self, y0: usize, dst: &mut [u8]) -> Result<()>;
+    /// Levels 1 .. of the chain, once every row of level 0 was asked for.
+    fn rest(&mut self) -> Result<Vec<Texture>>;
+}
+
+/// [`save`] of a full mip chain whose level 0 is never held whole: its
+/// tiles are compressed and written a group of rows at a time as `source`
+/// makes them, then the other levels are asked for and written. The
+/// bytes are those [`save`] writes for the same chain.
+pub fn save_streamed(
+    width: u32,
+    height: u32,
+    format: Format,
+    rounding: Rounding,
+    path: &Path,
+    opts: &SaveOptions,
+    source: &mut dyn Level0Source,
+) -> Result<()> {
+    let (header, tiles) = plan(width, height, format, true, rounding, opts)?;
+    let group = source.group_rows();
+    if group == 0 || !group.is_multiple_of(tiles.tile.1) {
+        return Err(encode_err(format!(
+            "level 0 comes in groups of {group} rows, not a multiple of the tile height {}",
+            tiles.tile.1
+        )));
+    }
+    let mut buffer = Texels::zeroed(format.channel_type, 0);
+    let mut failure = None;
+    let written = write_file(path, header, |meta, writer| {
+        let blocks: Vec<(usize, BlockIndex)> =
+            meta.enumerate_ordered_header_block_indices().collect();
+        let level0 = blocks
+            .iter()
+            .take_while(|(_, i)| i.level.x() == 0 && i.level.y() == 0)
+            .count();
+        let mut at = 0;
+        for y0 in (0..height as usize).step_by(group) {
+            let n = group.min(height as usize - y0);
+            let mut texels = std::mem::replace(&mut buffer, Texels::zeroed(format.channel_type, 0));
+            texels.resize(n * width as usize * format.channels as usize);
+            if let Err(e) = source.rows(y0, texels.bytes_mut()) {
+                failure = Some(e);
+                return Err(::exr::error::Error::Aborted);
+            }
+            let lvl = Texture::from_texels(width, n as u32, format, texels)
+                .map_err(|e| ::exr::error::Error::Invalid(e.to_string().into()))?;
+            let end = at
+                + blocks[at..level0]
+                    .iter()
+                    .take_while(|(_, i)| i.pixel_position.y() < y0 + n)
+                    .count();
+            write_blocks(writer, &blocks[at..end], |index| {
+                tiles.chunk(&lvl, y0, index, &meta.headers)
+            })?;
+            at = end;
+            buffer = lvl.into_texels();
+        }
+        drop(buffer);
+        debug_assert_eq!(at, level0);
+        let rest = match source.rest() {
+            Ok(r) => r,
+            Err(e) => {
+                failure = Some(e);
+                return Err(::exr::error::Error::Aborted);
+            }
+        };
+        let sizes = exr_level_sizes(width, height, rounding);
+        if rest.len() + 1 != sizes.len()
+            || rest
+                .iter()
+                .zip(&sizes[1..])
+                .any(|(l, &s)| (l.width(), l.height()) != s || l.format() != format)
+        {
+            return Err(::exr::error::Error::Invalid(
+                "the levels after level 0 do not make the chain".into(),
+            ));
+        }
+        write_blocks(writer, &blocks[level0..], |index| {
+            tiles.chunk(&rest[index.level.x() - 1], 0, index, &meta.headers)
+        })
+    });
+    match failure {
+        Some(e) => Err(e),
+        None => written,
+    }
+}
+
+/// How the tiles of a file [`plan`] made are laid out and compressed.
+struct Tiles {
+    /// Channel indices in file order (sorted by name).
+    order: Vec<usize>,
+    zip: bool,
+    tile: (usize, usize),
+}
+
+/// The header of a tiled EXR of `w`×`h` texels in `fmt` (mip-mapped or
+/// one level), after checking what the `exr` crate would panic on.
+fn plan(
+    w: u32,
+    h: u32,
+    fmt: Format,
+    mip: bool,
+    rounding: Rounding,
+    opts: &SaveOptions,
+) -> Result<(Header, Tiles)> {
     let (tw, th) = opts.tile;
     if tw == 0 || th == 0 {
         return Err(encode_err("tile size must be at least 1x1"));
     }
-    let fmt = first.format();
     let sample_type = match fmt.channel_type {
         ChannelType::F16 => SampleType::F16,
         ChannelType::F32 => SampleType::F32,
@@ -263,7 +385,7 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
     for (k, v) in &opts.attributes {
         put(k, v)?;
     }
-    let level_mode = if levels.len() > 1 {
+    let level_mode = if mip {
         LevelMode::MipMap
     } else {
         LevelMode::Singular
@@ -285,65 +407,62 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
     header.own_attributes = attrs;
     let zip = matches!(opts.compression, ExrCompression::Zip | ExrCompression::Zips);
     let tile = (tw as usize, th as usize);
+    Ok((header, Tiles { order, zip, tile }))
+}
+
+impl Tiles {
+    /// The compressed chunk of the tile `index`, from `lvl`, which holds
+    /// the level's rows from `y_off` on.
+    fn chunk(
+        &self,
+        lvl: &Texture,
+        y_off: usize,
+        index: &BlockIndex,
+        headers: &[Header],
+    ) -> ::exr::error::Result<Chunk> {
+        let tile = self.tile;
+        if self.zip {
+            Ok(Chunk {
+                layer_index: 0,
+                compressed_block: CompressedBlock::Tile(CompressedTileBlock {
+                    coordinates: TileCoordinates {
+                        tile_index: Vec2(
+                            index.pixel_position.x() / tile.0,
+                            index.pixel_position.y() / tile.1,
+                        ),
+                        level_index: index.level,
+                    },
+                    compressed_pixels_le: zip_tile(lvl, y_off, index, &self.order)?,
+                }),
+            })
+        } else {
+            let mut data = Vec::new();
+            tile_bytes(lvl, y_off, index, &self.order, &mut data);
+            UncompressedBlock {
+                index: *index,
+                data,
+            }
+            .compress_to_chunk(headers)
+        }
+    }
+}
+
+/// Write a single-part EXR with `header` to `path` atomically, the chunks
+/// by `body`, and the header's attributes sorted.
+fn write_file(
+    path: &Path,
+    header: Header,
+    body: impl FnOnce(
+        &MetaData,
+        &mut ::exr::block::writer::ChunkWriter<&mut std::io::BufWriter<&std::fs::File>>,
+    ) -> ::exr::error::UnitResult,
+) -> Result<()> {
     atomic::write(path, |out| {
         ::exr::block::write(
             &mut *out,
             std::iter::once(header).collect(),
             true,
-            |meta, writer| {
-                let blocks: Vec<(usize, BlockIndex)> =
-                    meta.enumerate_ordered_header_block_indices().collect();
-                let compress = |batch: &[(usize, BlockIndex)]| -> Vec<::exr::error::Result<Chunk>> {
-                    batch
-                        .par_iter()
-                        .map(|(_, index)| {
-                            let raw = tile_bytes(levels, index, &order);
-                            if zip {
-                                Ok(Chunk {
-                                    layer_index: 0,
-                                    compressed_block: CompressedBlock::Tile(CompressedTileBlock {
-                                        coordinates: TileCoordinates {
-                                            tile_index: Vec2(
-                                                index.pixel_position.x() / tile.0,
-                                                index.pixel_position.y() / tile.1,
-                                            ),
-                                            level_index: index.level,
-                                        },
-                                        compressed_pixels_le: zip_compress(raw)?,
-                                    }),
-                                })
-                            } else {
-                                UncompressedBlock {
-                                    index: *index,
-                                    data: raw,
-                                }
-                                .compress_to_chunk(&meta.headers)
-                            }
-                        })
-                        .collect()
-                };
-                // Bounded batches, compressed on all threads and written in
-                // order: batch k is written while batch k + 1 is being
-                // compressed, and never more than two batches of
-                // compressed tiles are in memory.
-                let mut batches = blocks.chunks(512);
-                let mut pending = batches.next().map(|b| (b, compress(b)));
-                while let Some((batch, chunks)) = pending {
-                    let next = batches.next();
-                    let (written, compressed) = rayon::join(
-                        || -> ::exr::error::UnitResult {
-                            for ((index_in_header, _), chunk) in batch.iter().zip(chunks) {
-                                writer.write_chunk(*index_in_header, chunk?)?;
-                            }
-                            Ok(())
-                        },
-                        || next.map(|b| (b, compress(b))),
-                    );
-                    written?;
-                    pending = compressed;
-                }
-                Ok(())
-            },
+            |meta, writer| body(&meta, writer),
         )
         .map_err(encode_err)?;
         // The exr crate writes custom attributes in hash-map order, which
@@ -352,6 +471,36 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
         std::io::Write::flush(out).map_err(encode_err)?;
         sort_header_attributes(out.get_ref()).map_err(encode_err)
     })
+}
+
+/// Compress `blocks` on all threads and write them in order, in bounded
+/// batches: batch k is written while batch k + 1 is being compressed, and
+/// never more than two batches of compressed tiles are in memory.
+fn write_blocks(
+    writer: &mut (impl ChunksWriter + Send),
+    blocks: &[(usize, BlockIndex)],
+    chunk: impl Fn(&BlockIndex) -> ::exr::error::Result<Chunk> + Sync,
+) -> ::exr::error::UnitResult {
+    let compress = |batch: &[(usize, BlockIndex)]| -> Vec<::exr::error::Result<Chunk>> {
+        batch.par_iter().map(|(_, index)| chunk(index)).collect()
+    };
+    let mut batches = blocks.chunks(512);
+    let mut pending = batches.next().map(|b| (b, compress(b)));
+    while let Some((batch, chunks)) = pending {
+        let next = batches.next();
+        let (written, compressed) = rayon::join(
+            || -> ::exr::error::UnitResult {
+                for ((index_in_header, _), chunk) in batch.iter().zip(chunks) {
+                    writer.write_chunk(*index_in_header, chunk?)?;
+                }
+                Ok(())
+            },
+            || next.map(|b| (b, compress(b))),
+        );
+        written?;
+        pending = compressed;
+    }
+    Ok(())
 }
 
 /// Rewrite the attributes of a single-part EXR header in name order, in
@@ -412,26 +561,27 @@ fn sort_header_attributes(mut file: &std::fs::File) -> std::io::Result<()> {
 
 /// The uncompressed bytes of one tile: for each line, for each channel in
 /// file order, the samples of that line (little-endian, which is native on
-/// every platform Rust's `half`/`f32` byte conversions are used on here).
-fn tile_bytes(levels: &[Texture], index: &BlockIndex, order: &[usize]) -> Vec<u8> {
-    let lvl = &levels[index.level.x()];
+/// every platform Rust's `half`/`f32` byte conversions are used on here),
+/// into `raw` (cleared first); `lvl` holds the level's rows from `y_off`
+/// on.
+fn tile_bytes(lvl: &Texture, y_off: usize, index: &BlockIndex, order: &[usize], raw: &mut Vec<u8>) {
     let lw = lvl.width() as usize;
     let ch = lvl.channels();
-    let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
+    let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y() - y_off);
     let (bw, bh) = (index.pixel_size.x(), index.pixel_size.y());
-    let mut raw = Vec::with_capacity(bw * bh * ch * lvl.channel_type().bytes());
+    raw.clear();
+    raw.reserve(bw * bh * ch * lvl.channel_type().bytes());
     for y in y0..y0 + bh {
         let start = (y * lw + x0) * ch;
         let end = start + bw * ch;
         for &c in order {
             match lvl.texels() {
-                Texels::F16(v) => gather(&v[start..end], ch, c, &mut raw, |x: f16| x.to_le_bytes()),
-                Texels::F32(v) => gather(&v[start..end], ch, c, &mut raw, |x: f32| x.to_le_bytes()),
+                Texels::F16(v) => gather(&v[start..end], ch, c, raw, |x: f16| x.to_le_bytes()),
+                Texels::F32(v) => gather(&v[start..end], ch, c, raw, |x: f32| x.to_le_bytes()),
                 _ => unreachable!("save checks for float texels"),
             }
         }
     }
-    raw
 }
 
 /// Append channel `c` of the interleaved texels `row` as little-endian
@@ -461,36 +611,44 @@ thread_local! {
         std::cell::RefCell::new(libdeflater::Compressor::new(ZIP_LEVEL));
 }
 
-/// OpenEXR's ZIP compression of one block: split even and odd bytes, delta
-/// predictor, zlib. Blocks that do not shrink are stored raw, as OpenEXR
-/// does (readers recognise them by their size).
-fn zip_compress(raw: Vec<u8>) -> ::exr::error::Result<Vec<u8>> {
-    let n = raw.len();
-    let half = n.div_ceil(2);
+/// OpenEXR's ZIP compression of one tile (see [`tile_bytes`]): split even
+/// and odd bytes, delta predictor, zlib. Blocks that do not shrink are
+/// stored raw, as OpenEXR does (readers recognise them by their size).
+/// Every buffer but the result is reused per thread: fresh ones per tile
+/// cost page faults whenever the allocator returns memory to the OS.
+fn zip_tile(
+    lvl: &Texture,
+    y_off: usize,
+    index: &BlockIndex,
+    order: &[usize],
+) -> ::exr::error::Result<Vec<u8>> {
     SCRATCH.with(|scratch| {
-        let (split, delta) = &mut *scratch.borrow_mut();
+        let [raw, split, delta, out] = &mut *scratch.borrow_mut();
+        tile_bytes(lvl, y_off, index, order, raw);
+        let n = raw.len();
         split.resize(n, 0);
         delta.resize(n, 0);
-        zip_compress_with(raw, &mut split[..n], &mut delta[..n], half)
+        zip_compress_with(raw, &mut split[..n], &mut delta[..n], out)
     })
 }
 
 thread_local! {
-    /// The byte-split copy of a block and its delta coding, reused per
-    /// thread.
-    static SCRATCH: std::cell::RefCell<(Vec<u8>, Vec<u8>)> =
-        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+    /// A tile's bytes, their byte-split copy, its delta coding and the
+    /// compressed bytes, reused per thread.
+    static SCRATCH: std::cell::RefCell<[Vec<u8>; 4]> =
+        const { std::cell::RefCell::new([Vec::new(), Vec::new(), Vec::new(), Vec::new()]) };
 }
 
-/// [`zip_compress`] with `split` and `delta` (`raw.len()` bytes each) as
-/// scratch buffers.
+/// The ZIP block of `raw`, with `split` and `delta` (`raw.len()` bytes
+/// each) and `out` as scratch buffers.
 fn zip_compress_with(
-    raw: Vec<u8>,
+    raw: &[u8],
     split: &mut [u8],
     delta: &mut [u8],
-    half: usize,
+    out: &mut Vec<u8>,
 ) -> ::exr::error::Result<Vec<u8>> {
     let n = raw.len();
+    let half = n.div_ceil(2);
     {
         let (even, odd) = split.split_at_mut(half);
         let (pairs, last) = raw.as_chunks::<2>();
@@ -511,17 +669,14 @@ fn zip_compress_with(
         *d = w[1].wrapping_sub(w[0]).wrapping_add(128);
     }
     let tmp = &*delta;
-    let out = DEFLATE.with(|c| {
+    let len = DEFLATE.with(|c| {
         let mut c = c.borrow_mut();
-        let mut out = vec![0u8; c.zlib_compress_bound(n)];
-        c.zlib_compress(tmp, &mut out).map(|len| {
-            out.truncate(len);
-            out
-        })
+        out.resize(c.zlib_compress_bound(n), 0);
+        c.zlib_compress(tmp, out)
     });
-    match out {
-        Ok(out) if out.len() < n => Ok(out),
-        Ok(_) => Ok(raw),
+    match len {
+        Ok(len) if len < n => Ok(out[..len].to_vec()),
+        Ok(_) => Ok(raw.to_vec()),
         Err(e) => Err(::exr::error::Error::Invalid(
             format!("deflate failed: {e:?}").into(),
         )),

@@ -341,6 +341,28 @@ impl Texels {
             ChannelType::F32 => Texels::F32(crate::mem::zeroed(len)),
         }
     }
+
+    /// Shorten to, or extend with zeros to, `len` values (keeping the
+    /// allocation when it is large enough).
+    pub fn resize(&mut self, len: usize) {
+        match self {
+            Texels::U8(v) => v.resize(len, 0),
+            Texels::U16(v) => v.resize(len, 0),
+            Texels::F16(v) => v.resize(len, f16::ZERO),
+            Texels::F32(v) => v.resize(len, 0.0),
+        }
+    }
+
+    /// The values as bytes in the host's byte order (little-endian on
+    /// every platform parvo's writers run on).
+    pub fn bytes_mut(&mut self) -> &mut [u8] {
+        match self {
+            Texels::U8(v) => v,
+            Texels::U16(v) => bytemuck::cast_slice_mut(v),
+            Texels::F16(v) => bytemuck::cast_slice_mut(v),
+            Texels::F32(v) => bytemuck::cast_slice_mut(v),
+        }
+    }
 }
 
 /// Decode stored values to linear-light f32 (`channels` values per texel).
