@@ -767,8 +767,14 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         && !s.normal_map
         && !same
     {
-        match Streamer::new(base, &options, src, out_format, association)? {
-            Ok(st) => match fused_group(st.band, s.tile.1 as usize) {
+        let builder = match Streamer::new(base, &options, src, out_format, association)? {
+            Ok(st) => Ok(Builder::Stream(st)),
+            Err(base) => {
+                Banded::new(base, &options, src, out_format, association).map(Builder::Band)
+            }
+        };
+        match builder {
+            Ok(st) => match fused_group(st.band(), s.tile.1 as usize) {
                 Some(group) => {
                     let mut source = Fused {
                         st: Some(st),
@@ -800,7 +806,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
                         blocks: None,
                     });
                 }
-                None => st.base,
+                None => st.into_base(),
             },
             Err(base) => base,
         }
@@ -1224,12 +1230,8 @@ fn build_colour(
     let base = if same {
         base
     } else {
-        let base = match build_streamed(base, options, src, out_format, association, progress)? {
-            Ok(levels) => return Ok((levels, None)),
-            Err(base) => base,
-        };
-        match build_banded(base, options, src, out_format, association, progress)? {
-            Ok(levels) => return Ok((levels, None)),
+        match Builder::new(base, options, src, out_format, association)? {
+            Ok(b) => return Ok((b.build_all(progress)?, None)),
             Err(base) => base,
         }
     };
@@ -1274,29 +1276,10 @@ fn build_colour(
     Ok((levels, note))
 }
 
-/// Most levels [`build_streamed`] makes band by band (bands of up to
+/// Most levels [`Streamer`] makes band by band (bands of up to
 /// 2^4 = 16 level-0 rows: a band of 16384-wide RGBA f32 is 4 MiB).
 const STREAM_LEVELS: u32 = 4;
 
-/// The colour chain of a source (u8, u16, or f16/f32 without NaN or
-/// infinities) converted to another type, box filter, even-sized levels, without a full-resolution f32 copy
-/// of any level: level 0 is cut into bands of 2^m rows (m ≤ 6 levels that
-/// halve exactly: both sides divisible by 2^m, m ≤ 4), and each band, on its own
-/// thread, is decoded to linear f32, reduced through levels 1..m with the
-/// box row kernel of the whole-level path ([`mip::fast`]), and every
-/// level's rows are alpha-associated and encoded into the output type as
-/// soon as they exist. Level m's f32 rows are kept (1/4^m of level 0) and
-/// the rest of the chain is built from them as before. Decoding, the row
-/// kernel, association and encoding are row-local, so the chain is bit for
-/// bit the whole-image one (`tests/mip_streamed.rs`).
-///
-/// `Err(base)` hands the source back when the shortcut does not apply
-/// (other filters, odd sizes, alpha coverage, float sources holding NaN or
-/// infinities): the caller tries [`build_banded`], then builds whole.
-/// Memory: the source, the output chain and two threads' bands (about
-/// 1.4 × 16 level-0 rows of f32 each): for RGBA8 → half EXR
-/// 4 + 8 × 4/3 bytes per level-0 texel, where decoding level 0 whole held
-/// 4 + 16 + 8 × 4/3 at the end of the build.
 /// Level-0 rows per group of a fused EXR write: a multiple of both the
 /// band height and the tile height, and at least 4 bands so that the
 /// threads share each group (`None` past 256 rows: odd tile heights).
@@ -1314,10 +1297,117 @@ fn fused_group(band: usize, tile_h: usize) -> Option<usize> {
     (tile_h > 0 && group <= 256).then_some(group)
 }
 
-/// The band-by-band builder as the level-0 source of a streamed EXR
-/// write, timing the build and reporting progress.
+/// Progress through a chain of `sizes`, counting the texels of levels
+/// above 0.
+fn chain_progress(sizes: &[(u32, u32)], levels_done: u32, texels_done: u64) -> mip::Progress {
+    mip::Progress {
+        levels_done,
+        levels_total: sizes.len() as u32,
+        texels_done,
+        texels_total: sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum(),
+    }
+}
+
+/// The chain from `level` (level `first` of a chain of `sizes`, in linear
+/// f32) down, built as the whole-level build does, `level` first;
+/// progress counts on from `done` texels of levels 1..=`first`.
+fn rest_of_chain(
+    level: Texture,
+    first: usize,
+    sizes: &[(u32, u32)],
+    options: &MipOptions,
+    done: u64,
+    progress: &mut dyn FnMut(mip::Progress),
+) -> Result<Vec<Texture>> {
+    progress(chain_progress(sizes, first as u32 + 1, done));
+    let rest_options = MipOptions {
+        max_levels: Some((sizes.len() - first) as u32),
+        ..*options
+    };
+    let chain = mip::build_with_progress(level, &rest_options, &mut |q| {
+        progress(chain_progress(
+            sizes,
+            q.levels_done + first as u32,
+            done + q.texels_done,
+        ))
+    })?;
+    Ok(chain.into_levels())
+}
+
+/// A band-by-band builder: the box shortcut or the general one.
+enum Builder<'a> {
+    Stream(Streamer<'a>),
+    Band(Banded<'a>),
+}
+
+impl<'a> Builder<'a> {
+    /// The box shortcut where it applies, else the general build;
+    /// `Err(base)` when neither does.
+    fn new(
+        base: Texture,
+        options: &'a MipOptions,
+        src: Format,
+        out_format: Format,
+        association: Option<AlphaMode>,
+    ) -> Result<std::result::Result<Self, Texture>> {
+        Ok(
+            match Streamer::new(base, options, src, out_format, association)? {
+                Ok(st) => Ok(Builder::Stream(st)),
+                Err(base) => {
+                    Banded::new(base, options, src, out_format, association).map(Builder::Band)
+                }
+            },
+        )
+    }
+
+    /// The whole chain, level 0 into one buffer.
+    fn build_all(mut self, progress: &mut dyn FnMut(mip::Progress)) -> Result<Vec<Texture>> {
+        let (base, out_format, sizes) = match &self {
+            Builder::Stream(st) => (&st.base, st.out_format, &st.sizes),
+            Builder::Band(bd) => (&bd.base, bd.out_format, &bd.sizes),
+        };
+        progress(chain_progress(sizes, 1, 0));
+        let (w, h) = (base.width(), base.height());
+        // Level 0 as little-endian bytes written in place by the bands on
+        // all threads (zero pages from the OS: no zeroing pass).
+        let n = w as usize * h as usize * out_format.channels as usize;
+        let mut out0 = Texels::zeroed(out_format.channel_type, n);
+        match &mut self {
+            Builder::Stream(st) => st.rows(0, out0.bytes_mut())?,
+            Builder::Band(bd) => bd.rows(0, out0.bytes_mut())?,
+        }
+        let mut levels = vec![Texture::from_texels(w, h, out_format, out0)?];
+        levels.extend(self.finish(progress)?);
+        Ok(levels)
+    }
+
+    /// Level-0 rows a call of `rows` must start and end on.
+    fn band(&self) -> usize {
+        match self {
+            Builder::Stream(st) => st.band,
+            Builder::Band(_) => 1,
+        }
+    }
+
+    fn into_base(self) -> Texture {
+        match self {
+            Builder::Stream(st) => st.base,
+            Builder::Band(bd) => bd.base,
+        }
+    }
+
+    fn finish(self, progress: &mut dyn FnMut(mip::Progress)) -> Result<Vec<Texture>> {
+        match self {
+            Builder::Stream(st) => st.finish(progress),
+            Builder::Band(bd) => bd.finish(progress),
+        }
+    }
+}
+
+/// A band-by-band builder as the level-0 source of a streamed EXR write,
+/// timing the build and reporting progress.
 struct Fused<'a, 'p> {
-    st: Option<Streamer<'a>>,
+    st: Option<Builder<'a>>,
     group: usize,
     build: std::time::Duration,
     progress: &'p mut dyn FnMut(Stage),
@@ -1334,10 +1424,19 @@ impl io::exr::Level0Source for Fused<'_, '_> {
             .st
             .as_mut()
             .ok_or_else(|| Error::InvalidOption("level 0 asked for after the rest".into()))?;
-        st.rows(y0, dst)?;
-        let y1 = (y0 + dst.len() / (st.base.width() as usize * st.out_format.texel_bytes())) as u64;
-        let w = st.base.width() as u64;
-        let texels_done = (1..=st.m).map(|k| (w >> k) * (y1 >> k)).sum();
+        let texels_done = match st {
+            Builder::Stream(st) => {
+                st.rows(y0, dst)?;
+                let w = st.base.width() as usize;
+                let y1 = (y0 + dst.len() / (w * st.out_format.texel_bytes())) as u64;
+                (1..=st.m).map(|k| (w as u64 >> k) * (y1 >> k)).sum()
+            }
+            // Level 0 only: levels 1.. are made at the end.
+            Builder::Band(bd) => {
+                bd.rows(y0, dst)?;
+                0
+            }
+        };
         self.build += t.elapsed();
         (self.progress)(Stage::Built { texels_done });
         Ok(())
@@ -1361,33 +1460,28 @@ impl io::exr::Level0Source for Fused<'_, '_> {
     }
 }
 
-fn build_streamed(
-    base: Texture,
-    options: &MipOptions,
-    src: Format,
-    out_format: Format,
-    association: Option<AlphaMode>,
-    progress: &mut dyn FnMut(mip::Progress),
-) -> Result<std::result::Result<Vec<Texture>, Texture>> {
-    let mut st = match Streamer::new(base, options, src, out_format, association)? {
-        Ok(st) => st,
-        Err(base) => return Ok(Err(base)),
-    };
-    progress(st.progress(1, 0));
-    let (w, h) = (st.base.width(), st.base.height());
-    // Level 0 whole, as little-endian bytes written in place by the bands
-    // on all threads (zero pages from the OS: no zeroing pass).
-    let n = w as usize * h as usize * out_format.channels as usize;
-    let mut out0 = Texels::zeroed(out_format.channel_type, n);
-    st.rows(0, out0.bytes_mut())?;
-    let mut levels = vec![Texture::from_texels(w, h, out_format, out0)?];
-    levels.extend(st.finish(progress)?);
-    Ok(Ok(levels))
-}
-
-/// The state of a band-by-band box build ([`build_streamed`]): the
-/// source, levels 1..=m in the output type (filled band by band), level
-/// m's f32 rows, kept to build the rest of the chain from.
+/// A band-by-band box build ([`Builder`]): the colour chain of a source (u8, u16, or f16/f32 without NaN or
+/// infinities) converted to another type, box filter, even-sized levels, without a full-resolution f32 copy
+/// of any level: level 0 is cut into bands of 2^m rows (m ≤ 6 levels that
+/// halve exactly: both sides divisible by 2^m, m ≤ 4), and each band, on its own
+/// thread, is decoded to linear f32, reduced through levels 1..m with the
+/// box row kernel of the whole-level path ([`mip::fast`]), and every
+/// level's rows are alpha-associated and encoded into the output type as
+/// soon as they exist. Level m's f32 rows are kept (1/4^m of level 0) and
+/// the rest of the chain is built from them as before. Decoding, the row
+/// kernel, association and encoding are row-local, so the chain is bit for
+/// bit the whole-image one (`tests/mip_streamed.rs`).
+///
+/// [`Streamer::new`] hands the source back when the shortcut does not
+/// apply (other filters, odd sizes, alpha coverage, float sources holding
+/// NaN or infinities): [`Builder::new`] then tries [`Banded`].
+/// Memory: the source, the output chain and two threads' bands (about
+/// 1.4 × 16 level-0 rows of f32 each): for RGBA8 → half EXR
+/// 4 + 8 × 4/3 bytes per level-0 texel (4 + 8/3 to EXR, which never holds
+/// level 0: [`io::exr::save_streamed`]), where decoding level 0 whole held
+/// 4 + 16 + 8 × 4/3 at the end of the build. The struct holds the source,
+/// levels 1..=m in the output type (filled band by band) and level m's f32
+/// rows, kept to build the rest of the chain from.
 struct Streamer<'a> {
     base: Texture,
     options: &'a MipOptions,
@@ -1457,18 +1551,6 @@ impl<'a> Streamer<'a> {
             outs,
             keep,
         }))
-    }
-
-    fn progress(&self, levels_done: u32, texels_done: u64) -> mip::Progress {
-        mip::Progress {
-            levels_done,
-            levels_total: self.sizes.len() as u32,
-            texels_done,
-            texels_total: self.sizes[1..]
-                .iter()
-                .map(|&(w, h)| w as u64 * h as u64)
-                .sum(),
-        }
     }
 
     /// Level-0 rows `y0 ..` (as many as `dst0` holds, a multiple of the
@@ -1579,13 +1661,6 @@ impl<'a> Streamer<'a> {
         } = self;
         drop(base);
         let done: u64 = sizes[1..=m].iter().map(|&(w, h)| w as u64 * h as u64).sum();
-        let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
-        progress(mip::Progress {
-            levels_done: m as u32 + 1,
-            levels_total: sizes.len() as u32,
-            texels_done: done,
-            texels_total,
-        });
         let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len() - 1);
         for (k, t) in outs.into_iter().enumerate() {
             levels.push(Texture::from_texels(
@@ -1595,20 +1670,10 @@ impl<'a> Streamer<'a> {
                 t,
             )?);
         }
+        // Level m is in `outs` already: the chain's first level is skipped.
         let level_m = Texture::from_f32(sizes[m].0, sizes[m].1, f32fmt, keep)?;
-        let rest_options = MipOptions {
-            max_levels: Some((sizes.len() - m) as u32),
-            ..*options
-        };
-        let chain = mip::build_with_progress(level_m, &rest_options, &mut |q| {
-            progress(mip::Progress {
-                levels_done: q.levels_done + m as u32,
-                levels_total: sizes.len() as u32,
-                texels_done: done + q.texels_done,
-                texels_total,
-            })
-        })?;
-        for l in chain.into_levels().into_iter().skip(1) {
+        let rest = rest_of_chain(level_m, m, &sizes, options, done, progress)?;
+        for l in rest.into_iter().skip(1) {
             levels.push(convert_level(associate(l, association)?, out_format)?);
         }
         Ok(levels)
@@ -1708,11 +1773,12 @@ fn bandable_source(base: &Texture, out: Format) -> bool {
         }
 }
 
-/// Level-1 rows per band of [`build_banded`].
+/// Rows per band of [`Banded`].
 const BAND_ROWS: usize = 16;
 
-/// The colour chain of a source converted to another type, for the
-/// filters and sizes [`build_streamed`] does not take (Kaiser, Lanczos,
+/// The general band-by-band build ([`Builder`]): the colour chain of a
+/// source converted to another type, for the filters and sizes
+/// [`Streamer`] does not take (Kaiser, Lanczos,
 /// Mitchell, triangle; the polyphase box of odd sizes; every wrap mode),
 /// without a full-resolution f32 copy of level 0:
 /// - level 0 is decoded, alpha-associated and encoded into the output type
@@ -1728,117 +1794,124 @@ const BAND_ROWS: usize = 16;
 /// output chain and level 1 in f32 (a quarter of level 0 in f32), where
 /// the whole-image build holds level 0 in f32 too.
 ///
-/// `Err(base)` hands the source back when it does not apply (alpha
+/// [`Banded::new`] hands the source back when it does not apply (alpha
 /// coverage, normal maps, a single level, a box filter the whole-image
 /// build reduces with its fast 2×2 kernel, float sources holding NaN or
 /// infinities).
-fn build_banded(
+struct Banded<'a> {
     base: Texture,
-    options: &MipOptions,
-    src: Format,
+    options: &'a MipOptions,
+    sizes: Vec<(u32, u32)>,
+    f32fmt: Format,
     out_format: Format,
     association: Option<AlphaMode>,
-    progress: &mut dyn FnMut(mip::Progress),
-) -> Result<std::result::Result<Vec<Texture>, Texture>> {
-    let (w, h) = (base.width() as usize, base.height() as usize);
-    let sizes = mip::level_sizes(
-        base.width(),
-        base.height(),
-        options.rounding,
-        options.max_levels,
-    );
-    let fast_box = options.filter == MipFilter::Box
-        && options.fast_paths
-        && sizes
-            .get(1)
-            .is_some_and(|&(w1, h1)| 2 * w1 as usize == w && 2 * h1 as usize == h);
-    let applies = sizes.len() >= 2
-        && !fast_box
-        && options.alpha_coverage.is_none()
-        && !options.normal_map
-        && bandable_source(&base, out_format);
-    if !applies {
-        return Ok(Err(base));
-    }
-    let ch = src.channels as usize;
-    let f32fmt =
-        Format::new(src.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha);
-    let stored = base.format();
-    let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
-    let mut p = mip::Progress {
-        levels_done: 1,
-        levels_total: sizes.len() as u32,
-        texels_done: 0,
-        texels_total,
-    };
-    progress(p);
-    let decode = |j: u32, row: &mut [f32]| {
-        crate::texel::decode_range_to_linear(&stored, base.texels(), j as usize * w * ch, row)
-    };
-    // Level 0, band by band into its output buffer.
-    let out_ch = out_format.channels as usize;
-    let mut out0 = Texels::zeroed(out_format.channel_type, w * h * out_ch);
-    {
-        let bytes: &mut [u8] = match &mut out0 {
-            Texels::U8(v) => v,
-            Texels::U16(v) => bytemuck::cast_slice_mut(v),
-            Texels::F16(v) => bytemuck::cast_slice_mut(v),
-            Texels::F32(v) => bytemuck::cast_slice_mut(v),
-        };
-        let row_bytes = bytes.len() / h;
-        bytes
-            .par_chunks_mut(BAND_ROWS * row_bytes)
-            .enumerate()
-            .try_for_each(|(b, dst)| -> Result<()> {
-                let rows = dst.len() / row_bytes;
-                let mut lin = vec![0f32; rows * w * ch];
-                for (r, row) in lin.chunks_exact_mut(w * ch).enumerate() {
-                    decode((b * BAND_ROWS + r) as u32, row);
-                }
-                let t = Texture::from_f32(w as u32, rows as u32, f32fmt, lin)?;
-                let t = convert_level(associate(t, association)?, out_format)?;
-                dst.copy_from_slice(&crate::io::le_bytes(t.texels()));
-                Ok(())
-            })?;
-    }
-    let level0 = Texture::from_texels(w as u32, h as u32, out_format, out0)?;
-    // Level 1, band by band, in f32.
-    let (w1, h1) = (sizes[1].0 as usize, sizes[1].1 as usize);
-    let reducer =
-        mip::separable::Reducer::new(f32fmt, w as u32, h as u32, w1 as u32, h1 as u32, options);
-    let mut lvl1: Vec<f32> = crate::mem::zeroed(w1 * h1 * ch);
-    lvl1.par_chunks_mut(BAND_ROWS * w1 * ch)
-        .enumerate()
-        .for_each(|(b, dst)| {
-            let y0 = b * BAND_ROWS;
-            let y1 = y0 + dst.len() / (w1 * ch);
-            reducer.band(y0, y1, decode, dst);
-        });
-    drop(base);
-    p.levels_done = 2;
-    p.texels_done = (w1 * h1) as u64;
-    progress(p);
-    // The rest from level 1, in f32, as the whole-level build does.
-    let level1 = Texture::from_f32(w1 as u32, h1 as u32, f32fmt, lvl1)?;
-    let rest_options = MipOptions {
-        max_levels: Some((sizes.len() - 1) as u32),
-        ..*options
-    };
-    let done = p.texels_done;
-    let chain = mip::build_with_progress(level1, &rest_options, &mut |q| {
-        progress(mip::Progress {
-            levels_done: q.levels_done + 1,
-            levels_total: sizes.len() as u32,
-            texels_done: done + q.texels_done,
-            texels_total,
+}
+
+impl<'a> Banded<'a> {
+    /// `Err(base)` when the band-by-band build does not apply.
+    fn new(
+        base: Texture,
+        options: &'a MipOptions,
+        src: Format,
+        out_format: Format,
+        association: Option<AlphaMode>,
+    ) -> std::result::Result<Self, Texture> {
+        let (w, h) = (base.width() as usize, base.height() as usize);
+        let sizes = mip::level_sizes(
+            base.width(),
+            base.height(),
+            options.rounding,
+            options.max_levels,
+        );
+        let fast_box = options.filter == MipFilter::Box
+            && options.fast_paths
+            && sizes
+                .get(1)
+                .is_some_and(|&(w1, h1)| 2 * w1 as usize == w && 2 * h1 as usize == h);
+        let applies = sizes.len() >= 2
+            && !fast_box
+            && options.alpha_coverage.is_none()
+            && !options.normal_map
+            && bandable_source(&base, out_format);
+        if !applies {
+            return Err(base);
+        }
+        Ok(Banded {
+            base,
+            options,
+            sizes,
+            f32fmt: Format::new(src.channels, ChannelType::F32, ColorSpace::Linear)
+                .with_alpha(src.alpha),
+            out_format,
+            association,
         })
-    })?;
-    let mut levels = Vec::with_capacity(sizes.len());
-    levels.push(level0);
-    for l in chain.into_levels() {
-        levels.push(convert_level(associate(l, association)?, out_format)?);
     }
-    Ok(Ok(levels))
+
+    /// Level-0 rows `y0 ..` (as many as `dst` holds) decoded, associated
+    /// and encoded into `dst` as little-endian bytes of the output type,
+    /// [`BAND_ROWS`] rows per task.
+    fn rows(&self, y0: usize, dst: &mut [u8]) -> Result<()> {
+        let w = self.base.width() as usize;
+        let ch = self.f32fmt.channels as usize;
+        let row_bytes = w * self.out_format.texel_bytes();
+        let stored = self.base.format();
+        dst.par_chunks_mut(BAND_ROWS * row_bytes)
+            .enumerate()
+            .try_for_each_init(Vec::<f32>::new, |lin, (b, dst)| -> Result<()> {
+                let rows = dst.len() / row_bytes;
+                lin.resize(rows * w * ch, 0.0);
+                let start = (y0 + b * BAND_ROWS) * w * ch;
+                crate::texel::decode_range_to_linear(&stored, self.base.texels(), start, lin);
+                encode_band(
+                    lin,
+                    w,
+                    rows,
+                    self.f32fmt,
+                    self.association,
+                    self.out_format,
+                    dst,
+                )
+            })
+    }
+
+    /// Levels 1..: level 1 filtered band by band in f32 from the level-0
+    /// rows each band's taps name, the rest built from it as the
+    /// whole-level build does.
+    fn finish(self, progress: &mut dyn FnMut(mip::Progress)) -> Result<Vec<Texture>> {
+        let Banded {
+            base,
+            options,
+            sizes,
+            f32fmt,
+            out_format,
+            association,
+        } = self;
+        let (w, h) = (base.width() as usize, base.height() as usize);
+        let ch = f32fmt.channels as usize;
+        let stored = base.format();
+        let decode = |j: u32, row: &mut [f32]| {
+            crate::texel::decode_range_to_linear(&stored, base.texels(), j as usize * w * ch, row)
+        };
+        let (w1, h1) = (sizes[1].0 as usize, sizes[1].1 as usize);
+        let reducer =
+            mip::separable::Reducer::new(f32fmt, w as u32, h as u32, w1 as u32, h1 as u32, options);
+        let mut lvl1: Vec<f32> = crate::mem::zeroed(w1 * h1 * ch);
+        lvl1.par_chunks_mut(BAND_ROWS * w1 * ch)
+            .enumerate()
+            .for_each(|(b, dst)| {
+                let y0 = b * BAND_ROWS;
+                let y1 = y0 + dst.len() / (w1 * ch);
+                reducer.band(y0, y1, decode, dst);
+            });
+        drop(base);
+        let level1 = Texture::from_f32(w1 as u32, h1 as u32, f32fmt, lvl1)?;
+        let rest = rest_of_chain(level1, 1, &sizes, options, (w1 * h1) as u64, progress)?;
+        let mut levels = Vec::with_capacity(sizes.len() - 1);
+        for l in rest {
+            levels.push(convert_level(associate(l, association)?, out_format)?);
+        }
+        Ok(levels)
+    }
 }
 
 /// Texels with a channel outside [0, 1] (or NaN).

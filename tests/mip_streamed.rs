@@ -174,76 +174,87 @@ fn streamed_chains_equal_whole_image_chains_bit_for_bit() {
     }
 }
 
-/// Box chains to EXR are written as they are built: level 0 a group of
-/// rows at a time, the group a multiple of the tile height and of the
-/// band (`io::exr::save_streamed`), or the whole chain first when no group
-/// of at most 256 rows is both (tile height 63). Every tile shape must
+/// Band-by-band chains to EXR are written as they are built: level 0 a
+/// group of rows at a time, the group a multiple of the tile height and of
+/// the band (`io::exr::save_streamed`), or the whole chain first when no
+/// group of at most 256 rows is both (tile height 63 with the box's bands
+/// of 2^m rows). Every tile shape must
 /// give the whole-image chain, and the same bytes as the whole-chain
 /// writer (`io::save`) with the same header.
 #[test]
 fn fused_exr_writes_equal_whole_chain_writes_for_every_tile_shape() {
     let dir = tempfile::tempdir().unwrap();
-    let (w, h) = (256, 200);
-    let src = source(w, h, ChannelType::U8, 77);
-    let png = dir.path().join("src_{level}.png");
-    io::png_levels::save(std::slice::from_ref(&src), &png).unwrap();
-    let input = png.to_str().unwrap().replace("{level}", "0");
-    let want = whole(
-        &src,
-        Format::new(4, ChannelType::F16, ColorSpace::Linear),
-        true,
-    );
-    for tile in [
-        (64, 64),
-        (8, 8),
-        (24, 48),
-        (64, 16),
-        (63, 63),
-        (256, 256),
-        (5, 200),
-    ] {
-        let out = dir.path().join(format!("o{}x{}.exr", tile.0, tile.1));
-        let settings = Settings {
-            tile,
-            ..Settings::default()
+    // The box shortcut (bands of 2^m rows) and the general band-by-band
+    // build (Kaiser, odd size: level 0 in any rows, level 1 at the end).
+    for (filter, w, h) in [(MipFilter::Box, 256, 200), (MipFilter::Kaiser, 131, 67)] {
+        let src = source(w, h, ChannelType::U8, 77);
+        let png = dir.path().join(format!("src{w}_{{level}}.png"));
+        io::png_levels::save(std::slice::from_ref(&src), &png).unwrap();
+        let input = png.to_str().unwrap().replace("{level}", "0");
+        let options = MipOptions {
+            filter,
+            ..MipOptions::default()
         };
-        let job = Job::new(&input, &out).unwrap();
-        pipeline::process(&job, &settings, &mut |_| {}).unwrap();
-        let got = io::load(out.to_str().unwrap(), &Limits::default())
-            .unwrap()
-            .levels;
-        assert_eq!(got.len(), want.len(), "tile {tile:?}");
-        for (k, (g, e)) in got.iter().zip(&want).enumerate() {
-            assert!(g.texels() == e.texels(), "tile {tile:?}: level {k} differs");
-        }
-        // The whole-chain writer, with the header the pipeline wrote.
-        let stored = io::stored_fingerprint(&out, OutputKind::Exr);
-        let again = dir.path().join(format!("w{}x{}.exr", tile.0, tile.1));
-        let save = SaveOptions {
-            tile,
-            fingerprint: stored,
-            attributes: vec![
-                ("parvo:filter".into(), "box".into()),
-                ("parvo:source".into(), src.format().to_string()),
-                (
-                    "parvo:rounding".into(),
-                    mip::Rounding::default().to_string(),
-                ),
-            ],
-            ..SaveOptions::default()
-        };
-        io::save(
-            &got,
-            mip::Rounding::default(),
-            &again,
-            OutputKind::Exr,
-            &save,
-        )
-        .unwrap();
-        assert!(
-            std::fs::read(&out).unwrap() == std::fs::read(&again).unwrap(),
-            "tile {tile:?}: bytes differ from the whole-chain writer"
+        let want = whole_with(
+            &src,
+            Format::new(4, ChannelType::F16, ColorSpace::Linear),
+            true,
+            &options,
         );
+        for tile in [
+            (64, 64),
+            (8, 8),
+            (24, 48),
+            (64, 16),
+            (63, 63),
+            (256, 256),
+            (5, 200),
+        ] {
+            let case = format!("{filter} {w}x{h}, tile {tile:?}");
+            let out = dir.path().join(format!("o{w}_{}x{}.exr", tile.0, tile.1));
+            let settings = Settings {
+                tile,
+                filter,
+                ..Settings::default()
+            };
+            let job = Job::new(&input, &out).unwrap();
+            pipeline::process(&job, &settings, &mut |_| {}).unwrap();
+            let got = io::load(out.to_str().unwrap(), &Limits::default())
+                .unwrap()
+                .levels;
+            assert_eq!(got.len(), want.len(), "{case}");
+            for (k, (g, e)) in got.iter().zip(&want).enumerate() {
+                assert!(g.texels() == e.texels(), "{case}: level {k} differs");
+            }
+            // The whole-chain writer, with the header the pipeline wrote.
+            let stored = io::stored_fingerprint(&out, OutputKind::Exr);
+            let again = dir.path().join(format!("w{w}_{}x{}.exr", tile.0, tile.1));
+            let save = SaveOptions {
+                tile,
+                fingerprint: stored,
+                attributes: vec![
+                    ("parvo:filter".into(), filter.to_string()),
+                    ("parvo:source".into(), src.format().to_string()),
+                    (
+                        "parvo:rounding".into(),
+                        mip::Rounding::default().to_string(),
+                    ),
+                ],
+                ..SaveOptions::default()
+            };
+            io::save(
+                &got,
+                mip::Rounding::default(),
+                &again,
+                OutputKind::Exr,
+                &save,
+            )
+            .unwrap();
+            assert!(
+                std::fs::read(&out).unwrap() == std::fs::read(&again).unwrap(),
+                "{case}: bytes differ from the whole-chain writer"
+            );
+        }
     }
 }
 

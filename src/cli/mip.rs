@@ -145,14 +145,16 @@ pub enum ExtArg {
     Memory, per level-0 texel of an input of B bytes per texel converted to an output type of O \
     bytes per texel (the chain adds a third): box filter with sides divisible by 2, and every other \
     filter or size, build band by band: at most B + 4/3·O, plus, for the other filters and odd \
-    sizes, level 1 in f32 (a quarter of 4 bytes per channel). A box-filtered chain to .exr never \
-    holds level 0 in the output type (each row of tiles is built, compressed and written): \
-    B + O/3. RGBA8 -> half EXR: 6.7 bytes (box), 18.7 (Kaiser, Lanczos, Mitchell, triangle, odd \
-    sizes); RGBA8 -> .ktx2/.dds in f16: 14.7 (box). Alpha coverage, normal maps, and float \
-    inputs holding NaN/Inf or written to 8/16-bit types build whole: add level 0 in f32 (4 bytes \
-    per channel). An output of the input's own type is built in that type (the box filter without \
-    f32 copies; the other filters decode the level they reduce to f32). --stats prints the \
-    peak.\n\n\
+    sizes, level 1 in f32 (a quarter of 4 bytes per channel). A chain to .exr never holds level 0 \
+    in the output type (each row of tiles is built, compressed and written as it is made): \
+    O/3 instead of 4/3·O. RGBA8 -> half EXR: 6.7 bytes (box), at most 10.7 (Kaiser, Lanczos, \
+    Mitchell, triangle, odd sizes; 8.2 measured at 16384x16384: the source is freed before the \
+    smaller levels are made); RGBA8 -> half .ktx2/.dds: 14.7 (box), 18.7 (the others). Alpha \
+    coverage, normal maps, and float inputs holding NaN/Inf or written to 8/16-bit types build \
+    whole: add level 0 in f32 (4 bytes per channel). An output of the input's own type is built \
+    in that type (the box filter without f32 copies; the other filters decode the level they \
+    reduce to f32). --stats prints the peak and the time of each phase (for .exr, where building \
+    and writing interleave, build is the time spent making levels and write the rest).\n\n\
     Exit codes: 0 every input succeeded; 1 some input failed (the others were written); 2 usage error."
 )]
 pub struct MipArgs {
