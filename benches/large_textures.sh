@@ -4,6 +4,7 @@
 # printing each parvo phase (read, build, write: `--stats`), the wall time
 # and the peak memory of both tools, and the per-texel time of each phase
 # relative to 4096² (the linear-cost goal of issue 19: at most 1.25x).
+# parvo's figures are the median of three runs per size, maketx's one run.
 #
 # Usage: benches/large_textures.sh [SIZES...]   (default: 4096 8192 16384)
 # Inputs are generated once into target/bench-large-SIZE.png (deterministic
@@ -56,12 +57,19 @@ base=""
 for n in "${SIZES[@]}"; do
     src="$PWD/target/bench-large-$n.png"
     [ -f "$src" ] || gen "$n" "$src"
-    read -r pw prss < <(measure parvo "$PARVO" mip "$src" -o "$WORK/p.exr" --filter box \
-        --compression zip --type f16 --threads "$THREADS" --stats)
-    stats=$(grep 'stats:' "$WORK/parvo.out")
-    rd=$(echo "$stats" | sed -E 's/.*read ([0-9.]+) s.*/\1/')
-    bd=$(echo "$stats" | sed -E 's/.*build ([0-9.]+) s.*/\1/')
-    wr=$(echo "$stats" | sed -E 's/.*write ([0-9.]+) s.*/\1/')
+    # parvo three times: the median of each column (a phase of 0.1-0.2 s
+    # at 4096² moves by half between runs on this host, and every ratio
+    # below divides by it).
+    runs=()
+    for _ in 1 2 3; do
+        read -r pw prss < <(measure parvo "$PARVO" mip "$src" -o "$WORK/p.exr" --filter box \
+            --compression zip --type f16 --threads "$THREADS" --stats)
+        stats=$(grep 'stats:' "$WORK/parvo.out")
+        runs+=("$(echo "$stats" | sed -E 's/.*read ([0-9.]+) s, build ([0-9.]+) s, write ([0-9.]+) s.*/\1 \2 \3/') $pw $prss")
+        rm -f "$WORK/p.exr"
+    done
+    median() { printf '%s\n' "${runs[@]}" | awk -v c="$1" '{print $c}' | sort -g | sed -n 2p; }
+    rd=$(median 1) bd=$(median 2) wr=$(median 3) pw=$(median 4) prss=$(median 5)
     rm -f "$WORK/p.exr"
     read -r mw mrss < <(measure maketx "$VENV_BIN/maketx" "$src" -o "$WORK/m.exr" --filter box \
         -d half --compression zip --threads "$THREADS")
