@@ -757,7 +757,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         && src.color_space == out_format.color_space
         && association.is_none()
         && s.alpha_coverage.is_none();
-    // A box-filtered colour chain to EXR never holds level 0 in the
+    // A band-by-band colour chain to EXR never holds level 0 in the
     // output type: each group of its rows is built, compressed and written
     // (`io::exr::save_streamed`), so level 0's output buffer is neither
     // allocated nor faulted in.
@@ -767,13 +767,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         && !s.normal_map
         && !same
     {
-        let builder = match Streamer::new(base, &options, src, out_format, association)? {
-            Ok(st) => Ok(Builder::Stream(st)),
-            Err(base) => {
-                Banded::new(base, &options, src, out_format, association).map(Builder::Band)
-            }
-        };
-        match builder {
+        match Builder::new(base, &options, src, out_format, association)? {
             Ok(st) => match fused_group(st.band(), s.tile.1 as usize) {
                 Some(group) => {
                     let mut source = Fused {
@@ -1284,17 +1278,20 @@ const STREAM_LEVELS: u32 = 4;
 /// band height and the tile height, and at least 4 bands so that the
 /// threads share each group (`None` past 256 rows: odd tile heights).
 fn fused_group(band: usize, tile_h: usize) -> Option<usize> {
+    if band == 0 || tile_h == 0 {
+        return None;
+    }
     let gcd = |mut a: usize, mut b: usize| {
         while b != 0 {
             (a, b) = (b, a % b);
         }
         a
     };
-    let mut group = band / gcd(band, tile_h).max(1) * tile_h;
+    let mut group = band / gcd(band, tile_h) * tile_h;
     while group < 4 * band {
         group *= 2;
     }
-    (tile_h > 0 && group <= 256).then_some(group)
+    (group <= 256).then_some(group)
 }
 
 /// Progress through a chain of `sizes`, counting the texels of levels

@@ -255,6 +255,17 @@ fn fused_exr_writes_equal_whole_chain_writes_for_every_tile_shape() {
                 "{case}: bytes differ from the whole-chain writer"
             );
         }
+        // A zero tile height from a library caller is an error, not a
+        // group size search that never ends.
+        let out = dir.path().join(format!("zero{w}.exr"));
+        let settings = Settings {
+            tile: (64, 0),
+            filter,
+            ..Settings::default()
+        };
+        let job = Job::new(&input, &out).unwrap();
+        assert!(pipeline::process(&job, &settings, &mut |_| {}).is_err());
+        assert!(!out.exists());
     }
 }
 
