@@ -217,6 +217,26 @@ pub fn load(spec: &str, limits: &Limits) -> Result<Loaded> {
 
 /// [`load`] with [`LoadOptions`].
 pub fn load_with(spec: &str, limits: &Limits, options: &LoadOptions) -> Result<Loaded> {
+    load_overlapped(spec, limits, options, None)
+}
+
+/// Work for the core a single-threaded decoder leaves idle, given the
+/// image's width, height, channel count and channel type as soon as its
+/// header is read (see [`load_overlapped`]).
+pub type Overlap<'a> = &'a mut (dyn FnMut(u32, u32, u8, ChannelType) + Send);
+
+/// [`load_with`], running `overlap` on another thread while the image is
+/// decoded, where the decoder runs on one thread (PNG, JPEG and the other
+/// formats `image` reads); the load returns once both are done. Other
+/// formats (OpenEXR, read on all threads; TIFF, KTX2, DDS, `builtin:`)
+/// never call it. A caller uses it to allocate and fault in the buffers
+/// it will fill next, off the critical path.
+pub fn load_overlapped(
+    spec: &str,
+    limits: &Limits,
+    options: &LoadOptions,
+    overlap: Option<Overlap<'_>>,
+) -> Result<Loaded> {
     if crate::builtin::is_builtin(spec) {
         let (kind, size) = crate::builtin::parse(spec)?;
         limits.check(size as u64, size as u64, size as u64 * size as u64 * 4)?;
@@ -265,8 +285,9 @@ pub fn load_with(spec: &str, limits: &Limits, options: &LoadOptions) -> Result<L
         })?;
     let magic = &magic[..n];
     // The decoders are dependencies; a panic in one on a malformed file
-    // becomes a decode error, never a crash of the caller.
-    std::panic::catch_unwind(|| {
+    // becomes a decode error, never a crash of the caller. (What `overlap`
+    // did before a panic is the caller's buffers, valid as they are.)
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         if options.channels.is_some() && !magic.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
             return Err(Error::InvalidOption(
                 "--channels selects channels of OpenEXR files; this input is not one".into(),
@@ -285,9 +306,9 @@ pub fn load_with(spec: &str, limits: &Limits, options: &LoadOptions) -> Result<L
         {
             tiff::load(path, limits, options)
         } else {
-            load_image(path, limits, options)
+            load_image(path, limits, options, overlap)
         }
-    })
+    }))
     .unwrap_or_else(|p| {
         Err(Error::Decode {
             format: "input",
@@ -380,7 +401,12 @@ fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>)> {
     Ok((ColorSpace::Srgb, None))
 }
 
-fn load_image(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loaded> {
+fn load_image(
+    path: &Path,
+    limits: &Limits,
+    options: &LoadOptions,
+    overlap: Option<Overlap<'_>>,
+) -> Result<Loaded> {
     use image::{DynamicImage, ImageDecoder, ImageFormat};
     let decode = |reason: String| Error::Decode {
         format: "image",
@@ -427,25 +453,42 @@ fn load_image(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loa
     let orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
     let mut il = limits.to_image();
     il.reserve(decoder.total_bytes()).map_err(lim)?;
-    let img = match decoder.color_type() {
+    let (w, h) = decoder.dimensions();
+    let ct = decoder.color_type();
+    let overlap = overlap.map(|f| {
+        let ch = ct.channel_count();
+        let ty = match ct.bytes_per_pixel() / ch {
+            1 => ChannelType::U8,
+            2 => ChannelType::U16,
+            _ => ChannelType::F32,
+        };
+        move || f(w, h, ch, ty)
+    });
+    let img = match ct {
         // 8-bit images (the common large case) are decoded into a buffer
         // whose pages another thread maps meanwhile (`mem::populate`):
         // the decoder runs on one core, and first touches of a 16384²
-        // RGBA8 image cost it seconds.
+        // RGBA8 image cost it seconds. `overlap` follows on that thread.
         image::ColorType::L8
         | image::ColorType::La8
         | image::ColorType::Rgb8
         | image::ColorType::Rgba8 => {
-            let (w, h) = decoder.dimensions();
-            let ct = decoder.color_type();
             let mut buf: Vec<u8> = crate::mem::zeroed(
                 usize::try_from(decoder.total_bytes())
                     .map_err(|_| Error::Limits("image larger than memory".into()))?,
             );
             let (ptr, len) = (buf.as_ptr() as usize, buf.len());
+            let populate = len >= 64 << 20;
             std::thread::scope(|s| {
-                if len >= 64 << 20 {
-                    s.spawn(move || crate::mem::populate(ptr as *const u8, len));
+                if populate || overlap.is_some() {
+                    s.spawn(move || {
+                        if populate {
+                            crate::mem::populate(ptr as *const u8, len);
+                        }
+                        if let Some(mut f) = overlap {
+                            f();
+                        }
+                    });
                 }
                 decoder.read_image(&mut buf)
             })
@@ -466,7 +509,13 @@ fn load_image(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loa
                 ),
             }
         }
-        _ => DynamicImage::from_decoder(decoder).map_err(lim)?,
+        _ => std::thread::scope(|s| {
+            if let Some(f) = overlap {
+                s.spawn(f);
+            }
+            DynamicImage::from_decoder(decoder)
+        })
+        .map_err(lim)?,
     };
     let (w, h) = (img.width(), img.height());
     let f = |ch: u8, ty: ChannelType| {
