@@ -154,7 +154,9 @@ pub enum ExtArg {
     whole: add level 0 in f32 (4 bytes per channel). An output of the input's own type is built \
     in that type (the box filter without f32 copies; the other filters decode the level they \
     reduce to f32). --stats prints the peak and the time of each phase (for .exr, where building \
-    and writing interleave, build is the time spent making levels and write the rest).\n\n\
+    and writing interleave, build is the time spent making levels and write the rest; read \
+    includes mapping the pages of levels 1-4 on the core a one-thread decoder such as PNG's leaves \
+    idle).\n\n\
     Exit codes: 0 every input succeeded; 1 some input failed (the others were written); 2 usage error."
 )]
 pub struct MipArgs {
