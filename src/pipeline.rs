@@ -1318,7 +1318,9 @@ fn prefault_streamed(
     ch: u8,
     ty: ChannelType,
 ) -> Option<Vec<Texels>> {
+    // (A dry run builds nothing: no buffers to make.)
     let fused = job.kind == OutputKind::Exr
+        && !s.dry_run
         && s.compress.is_none()
         && s.roughness.is_none()
         && !s.normal_map
