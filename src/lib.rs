@@ -70,6 +70,7 @@ mod cpu;
 pub mod error;
 pub mod io;
 mod mem;
+mod par;
 pub mod mip;
 pub mod pipeline;
 pub mod sample;

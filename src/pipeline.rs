@@ -970,7 +970,7 @@ fn encode_chain(
     }
     #[cfg(feature = "encode")]
     {
-        use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+        use std::sync::atomic::{AtomicU64, Ordering};
         let first = levels
             .first()
             .ok_or_else(|| Error::InvalidOption("nothing to encode: no levels".into()))?;
@@ -982,11 +982,13 @@ fn encode_chain(
             total_texels: total,
         });
         let done = AtomicU64::new(0);
-        let finished = AtomicBool::new(false);
         let t0 = Instant::now();
-        let result = std::thread::scope(|scope| {
-            let worker = scope.spawn(|| {
-                let r = levels
+        // Progress is polled from this thread while the pool encodes; a
+        // job of a batch (on a pool thread) encodes in place instead
+        // (crate::par: a pool thread that slept here hung the batch).
+        let result = crate::par::polled(
+            || {
+                levels
                     .par_iter()
                     .map(|l| -> Result<(Vec<u8>, BlockLevel)> {
                         let t = Instant::now();
@@ -1005,22 +1007,15 @@ fn encode_chain(
                             },
                         ))
                     })
-                    .collect::<Result<Vec<_>>>();
-                finished.store(true, Ordering::Release);
-                r
-            });
-            while !finished.load(Ordering::Acquire) {
+                    .collect::<Result<Vec<_>>>()
+            },
+            std::time::Duration::from_millis(50),
+            || {
                 progress(Stage::Encoded {
                     texels_done: done.load(Ordering::Relaxed),
-                });
-                std::thread::sleep(std::time::Duration::from_millis(50));
-            }
-            worker.join().unwrap_or_else(|_| {
-                Err(Error::InvalidOption(
-                    "internal error: the encoder panicked".into(),
-                ))
-            })
-        })?;
+                })
+            },
+        )?;
         progress(Stage::Encoded { texels_done: total });
         let encode_s = t0.elapsed().as_secs_f64();
         let mut data = Vec::with_capacity(result.len());

@@ -10,7 +10,6 @@
 //! [`SAT_LEVEL`] for a summed-area-table entry) in the top 8.
 
 use std::io::{BufRead, Write};
-use std::sync::mpsc;
 
 use rayon::prelude::*;
 
@@ -177,19 +176,13 @@ impl SceneSetup<'_> {
         let sat = self.layout.sat_entry().unwrap_or(texel);
         let mut reads = 0u64;
         let groups: Vec<&[Query]> = queries.chunks(CHUNK * 8).collect();
-        let (tx, rx) = mpsc::sync_channel::<(usize, Vec<Vec<u64>>)>(2);
-        let result = std::thread::scope(|scope| -> Result<()> {
-            let producer = scope.spawn(move || {
-                for (gi, g) in groups.iter().enumerate() {
-                    let traces: Vec<Vec<u64>> =
-                        g.par_chunks(CHUNK).map(|c| self.chunk_trace(c)).collect();
-                    if tx.send((gi, traces)).is_err() {
-                        return;
-                    }
-                }
-            });
-            let mut done = 0u64;
-            for (gi, traces) in rx {
+        // Sampling (on the pool) overlaps simulation (here), unless this
+        // is a pool thread: see crate::par.
+        let result = crate::par::produce_consume(
+            &groups,
+            2,
+            |_, g| -> Vec<Vec<u64>> { g.par_chunks(CHUNK).map(|c| self.chunk_trace(c)).collect() },
+            |gi, traces| -> Result<()> {
                 for t in &traces {
                     for &a in t {
                         let (addr, level) = unpack(a);
@@ -203,15 +196,10 @@ impl SceneSetup<'_> {
                     }
                     reads += t.len() as u64;
                 }
-                done = ((gi + 1) * CHUNK * 8).min(total as usize) as u64;
-                progress(done, total);
-            }
-            let _ = done;
-            producer
-                .join()
-                .map_err(|_| Error::InvalidOption("the sampling thread panicked".into()))?;
-            Ok(())
-        });
+                progress(((gi + 1) * CHUNK * 8).min(total as usize) as u64, total);
+                Ok(())
+            },
+        );
         result?;
         Ok(RunStats {
             stats: sim.into_stats(),

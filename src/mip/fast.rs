@@ -72,6 +72,54 @@ pub fn try_reduce(
     Texture::from_texels(w, h, fmt, texels).map(|t| Some((t, finite)))
 }
 
+/// The 2×2 box of an even-sized level of any stored type, to linear f32
+/// (the unrounded level a chain reduces further): each pair of source rows
+/// is decoded into per-thread scratch and reduced with [`box_row_f32`], so
+/// no decoded copy of the whole level exists. `None` when the box does not
+/// apply (another filter, or sizes that do not halve exactly). The flag is
+/// as [`try_reduce`]'s.
+pub fn try_reduce_linear(
+    src: &Texture,
+    w: u32,
+    h: u32,
+    options: &MipOptions,
+) -> Option<(Vec<f32>, bool)> {
+    let (sw, sh) = (src.width() as usize, src.height() as usize);
+    if options.filter != MipFilter::Box || sw != 2 * w as usize || sh != 2 * h as usize {
+        return None;
+    }
+    let fmt = src.format();
+    let straight = fmt
+        .alpha_channel()
+        .filter(|_| fmt.alpha == AlphaMode::Straight);
+    if let (Texels::F32(s), ColorSpace::Linear) = (src.texels(), fmt.color_space) {
+        return Some(box_f32(s, sw, fmt, straight));
+    }
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let ch = fmt.channels as usize;
+    let row = w as usize * ch;
+    let src_row = sw * ch;
+    let mut dst: Vec<f32> = crate::mem::zeroed(row * h as usize);
+    let per = rows_per_task(row * 4);
+    let finite = AtomicBool::new(ch == 4);
+    let texels = src.texels();
+    dst.par_chunks_mut(row * per).enumerate().for_each_init(
+        || vec![0f32; 2 * src_row],
+        |scratch, (task, out)| {
+            let (r0, r1) = scratch.split_at_mut(src_row);
+            for (i, d) in out.chunks_exact_mut(row).enumerate() {
+                let y = task * per + i;
+                crate::texel::decode_range_to_linear(&fmt, texels, 2 * y * src_row, r0);
+                crate::texel::decode_range_to_linear(&fmt, texels, (2 * y + 1) * src_row, r1);
+                if !box_row_f32(r0, r1, d, ch, straight) {
+                    finite.store(false, Ordering::Relaxed);
+                }
+            }
+        },
+    );
+    Some((dst, finite.into_inner()))
+}
+
 fn rows_per_task(row_bytes: usize) -> usize {
     (TASK_BYTES / row_bytes.max(1)).max(1)
 }

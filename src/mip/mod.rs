@@ -35,6 +35,7 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
+use crate::texel::{ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::Wrap;
 
@@ -341,17 +342,79 @@ pub fn build_reduced_levels(base: &Texture, options: &MipOptions) -> Result<Vec<
         options.rounding,
         options.max_levels,
     );
+    reduced_levels(base, &sizes, options, deferred, &mut |_, _| {})
+}
+
+/// The form every level is reduced from: linear f32 with the source's
+/// channels and alpha mode, never rounded to the stored type.
+fn working_format(f: Format) -> Format {
+    Format::new(f.channels, ChannelType::F32, ColorSpace::Linear).with_alpha(f.alpha)
+}
+
+/// Levels 1.. of `base`'s chain of `sizes`, each reduced from the
+/// unrounded level before it (level 0 as stored, then linear f32) and
+/// rounded to `base`'s format once, as it is stored; `done(k, texels)`
+/// after level `k`. A chain of linear f32 keeps no second copy: its stored
+/// levels are the working ones.
+fn reduced_levels(
+    base: &Texture,
+    sizes: &[(u32, u32)],
+    options: &MipOptions,
+    deferred: bool,
+    done: &mut dyn FnMut(usize, u64),
+) -> Result<Vec<Texture>> {
+    let stored = base.format();
+    let separate = stored != working_format(stored);
     let coverage0 = coverage_target(base, options);
-    let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len() - 1);
-    for &(w, h) in &sizes[1..] {
-        let prev = levels.last().unwrap_or(base);
-        let (next, finite) = reduce_post(prev, w, h, options, coverage0)?;
-        if deferred && levels.is_empty() && !finite {
+    let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len().saturating_sub(1));
+    // The unrounded last level, when it is not the stored one.
+    let mut work: Option<Texture> = None;
+    for (k, &(w, h)) in sizes.iter().enumerate().skip(1) {
+        let prev = match (&work, levels.last()) {
+            (Some(t), _) => t,
+            (None, Some(t)) => t,
+            (None, None) => base,
+        };
+        let (mut next, finite) = reduce_working(prev, w, h, options)?;
+        if let (Some(r), Some(c0)) = (options.alpha_coverage, coverage0) {
+            let store = options.alpha_store.unwrap_or(stored.channel_type);
+            alpha::preserve_coverage(&mut next, r, c0, store);
+        }
+        if deferred && k == 1 && !finite {
             nan::check_via_reduced(base, &next)?;
         }
-        levels.push(next);
+        if separate {
+            let mut out = Texture::new(w, h, stored)?;
+            let Texels::F32(lin) = next.texels() else {
+                return Err(Error::InvalidOption("working levels are f32".into()));
+            };
+            crate::texel::encode_from_linear(&stored, lin, out.texels_mut());
+            levels.push(out);
+            work = Some(next);
+        } else {
+            levels.push(next);
+        }
+        done(k, w as u64 * h as u64);
     }
     Ok(levels)
+}
+
+/// One reduction to `w × h` in the working form (see [`working_format`]),
+/// with the fast box where it applies; the flag says every value came out
+/// finite.
+fn reduce_working(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result<(Texture, bool)> {
+    let fast = options
+        .fast_paths
+        .then(|| fast::try_reduce_linear(src, w, h, options))
+        .flatten();
+    let (v, finite) = match fast {
+        Some(r) => r,
+        None => separable::reduce_linear_checked(src, w, h, options),
+    };
+    Ok((
+        Texture::from_f32(w, h, working_format(src.format()), v)?,
+        finite,
+    ))
 }
 
 fn coverage_target(base: &Texture, options: &MipOptions) -> Option<f32> {
@@ -359,21 +422,6 @@ fn coverage_target(base: &Texture, options: &MipOptions) -> Option<f32> {
         (Some(r), Some(_)) => Some(alpha::coverage(base, r)),
         _ => None,
     }
-}
-
-fn reduce_post(
-    prev: &Texture,
-    w: u32,
-    h: u32,
-    options: &MipOptions,
-    coverage0: Option<f32>,
-) -> Result<(Texture, bool)> {
-    let (mut next, finite) = reduce_tracked(prev, w, h, options)?;
-    if let (Some(r), Some(c0)) = (options.alpha_coverage, coverage0) {
-        let store = options.alpha_store.unwrap_or(next.channel_type());
-        alpha::preserve_coverage(&mut next, r, c0, store);
-    }
-    Ok((next, finite))
 }
 
 /// Build the full chain of `base` (see the module docs).
@@ -408,7 +456,6 @@ pub fn build_with_progress(
         options.max_levels,
     );
     let texels_total: u64 = sizes[1..].iter().map(|&(w, h)| w as u64 * h as u64).sum();
-    let coverage0 = coverage_target(&base, options);
     let mut p = Progress {
         levels_done: 1,
         levels_total: sizes.len() as u32,
@@ -416,20 +463,14 @@ pub fn build_with_progress(
         texels_total,
     };
     progress(p);
-    let mut levels = Vec::with_capacity(sizes.len());
-    // The level the next one is reduced from, pushed once it is replaced.
-    let mut prev = base;
-    for &(w, h) in &sizes[1..] {
-        let (next, finite) = reduce_post(&prev, w, h, options, coverage0)?;
-        if deferred && levels.is_empty() && !finite {
-            nan::check_via_reduced(&prev, &next)?;
-        }
-        levels.push(std::mem::replace(&mut prev, next));
+    let rest = reduced_levels(&base, &sizes, options, deferred, &mut |_, texels| {
         p.levels_done += 1;
-        p.texels_done += w as u64 * h as u64;
+        p.texels_done += texels;
         progress(p);
-    }
-    levels.push(prev);
+    })?;
+    let mut levels = Vec::with_capacity(sizes.len());
+    levels.push(base);
+    levels.extend(rest);
     Ok(MipChain {
         levels,
         options: *options,

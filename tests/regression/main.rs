@@ -5,7 +5,9 @@
 mod util;
 
 mod alpha_coverage_bound_broken_by_8bit_rounding;
+mod compress_batch_hangs;
 mod dds_headers_pillow_read_as_black;
+mod eight_bit_chains_drift;
 mod exif_orientation_ignored;
 mod exr_bytes_differ_between_runs;
 mod exr_channel_names_lost;

@@ -7,8 +7,16 @@ use std::process::{Command, Output};
 
 use exr::prelude::*;
 
+/// The binary under test: this build's, or the one `PARVO_BIN` names (to
+/// check that a regression test fails on an older build).
+pub fn bin() -> std::path::PathBuf {
+    std::env::var_os("PARVO_BIN")
+        .map(Into::into)
+        .unwrap_or_else(|| env!("CARGO_BIN_EXE_parvo").into())
+}
+
 pub fn parvo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_parvo"))
+    Command::new(bin())
         .args(args)
         .output()
         .expect("run parvo")
@@ -16,7 +24,7 @@ pub fn parvo(args: &[&str]) -> Output {
 
 pub fn parvo_stdin(args: &[&str], stdin: &str) -> Output {
     use std::io::Write;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_parvo"))
+    let mut child = Command::new(bin())
         .args(args)
         .stdin(std::process::Stdio::piped())
         .stdout(std::process::Stdio::piped())
