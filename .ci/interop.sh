@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Interop checks: parvo's files as other programs read them, and other
 # programs' files as parvo reads them (scripts/interop/*.py: OpenEXR via
-# OpenImageIO and maketx, DDS via Pillow and OpenImageIO, ...). Installs
+# OpenImageIO and maketx, DDS via Pillow and OpenImageIO, other projects'
+# test files in tests/data/peer/ via peer.py, ...). Installs
 # the pinned readers into a venv under target/ with the project's own script
 # (scripts/setup-interop.sh). Prints one line per check, exits non-zero on
 # any failure.
