@@ -41,8 +41,10 @@ pub enum Error {
         actual: usize,
     },
     /// A NaN or infinite value in float input under [`crate::NanPolicy::Error`].
-    #[error("non-finite value {value} at texel ({x}, {y}) channel {channel}")]
+    #[error("non-finite value {value} at texel ({x}, {y}) channel {channel}{}", level_suffix(*level))]
     NonFinite {
+        /// The mip level (0 unless a file's own level holds the value).
+        level: u32,
         /// Column of the first bad texel (row-major scan order).
         x: u32,
         /// Row of the first bad texel.
@@ -98,6 +100,14 @@ pub enum Error {
     /// `io::Limits` for the defaults and how to raise them.
     #[error("limit exceeded: {0}")]
     Limits(String),
+}
+
+fn level_suffix(level: u32) -> String {
+    if level == 0 {
+        String::new()
+    } else {
+        format!(" of level {level}")
+    }
 }
 
 impl Error {

@@ -29,7 +29,11 @@ pub fn on_pool_thread() -> bool {
 /// every `every` while it runs, then returns its result. On a rayon pool
 /// thread `work` runs in place and `poll` is not called (see the module
 /// docs). A panic in `work` is resumed on this thread.
-pub fn polled<T: Send>(work: impl FnOnce() -> T + Send, every: Duration, mut poll: impl FnMut()) -> T {
+pub fn polled<T: Send>(
+    work: impl FnOnce() -> T + Send,
+    every: Duration,
+    mut poll: impl FnMut(),
+) -> T {
     if on_pool_thread() {
         return work();
     }
@@ -41,12 +45,9 @@ pub fn polled<T: Send>(work: impl FnOnce() -> T + Send, every: Duration, mut pol
             let _ = tx.send(());
             r
         });
-        loop {
-            match rx.recv_timeout(every) {
-                Err(mpsc::RecvTimeoutError::Timeout) => poll(),
-                // Done, or the worker panicked (the sender was dropped).
-                _ => break,
-            }
+        // Until the worker is done (or panicked: the sender is dropped).
+        while let Err(mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(every) {
+            poll();
         }
         match worker.join() {
             Ok(r) => r,

@@ -294,6 +294,55 @@ impl Job {
     }
 }
 
+/// File extensions [`expand_inputs`] takes from a directory: the
+/// containers parvo reads (case does not matter).
+pub const IMAGE_EXTENSIONS: &[&str] = &[
+    "png", "jpg", "jpeg", "tif", "tiff", "tx", "hdr", "exr", "ktx2", "dds",
+];
+
+/// The inputs of a batch with every directory replaced by the image files
+/// in it (not its subdirectories; hidden files skipped; by name, so the
+/// order does not depend on the file system), files and `builtin:` names
+/// kept as given. A directory holding no image is an error, as is one
+/// that cannot be listed.
+pub fn expand_inputs(inputs: &[String]) -> Result<Vec<String>> {
+    let mut out = Vec::with_capacity(inputs.len());
+    for input in inputs {
+        let path = Path::new(input);
+        if crate::builtin::is_builtin(input) || !path.is_dir() {
+            out.push(input.clone());
+            continue;
+        }
+        let io_err = |e| Error::Io {
+            path: path.to_path_buf(),
+            action: "cannot list the directory".into(),
+            error: e,
+        };
+        let mut found = Vec::new();
+        for entry in std::fs::read_dir(path).map_err(io_err)? {
+            let p = entry.map_err(io_err)?.path();
+            let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
+            let image = p.extension().is_some_and(|e| {
+                IMAGE_EXTENSIONS
+                    .iter()
+                    .any(|x| e.to_string_lossy().eq_ignore_ascii_case(x))
+            });
+            if image && p.is_file() && !name.is_some_and(|n| n.starts_with('.')) {
+                found.push(p.to_string_lossy().into_owned());
+            }
+        }
+        if found.is_empty() {
+            return Err(Error::InvalidOption(format!(
+                "directory {input} holds no image parvo reads (.{})",
+                IMAGE_EXTENSIONS.join(", .")
+            )));
+        }
+        found.sort();
+        out.extend(found);
+    }
+    Ok(out)
+}
+
 /// The checks that need no input read: option ranges, a channel type the
 /// container cannot store, round-up sizes where the container fixes them.
 /// The command line reports these as usage errors.
@@ -491,8 +540,12 @@ pub struct Outcome {
     pub write_s: f64,
     /// What the loader or the build did that the user would not assume.
     pub notes: Vec<String>,
-    /// Block compression figures, when the output is block-compressed.
+    /// Block compression figures, when this run encoded blocks.
     pub blocks: Option<BlockReport>,
+    /// The block format the output holds (`BC7_SRGB`, ...) when it is
+    /// block-compressed, also when this run encoded nothing (`--update`,
+    /// a dry run).
+    pub block_format: Option<String>,
 }
 
 /// Progress of one job.
@@ -609,6 +662,14 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     let src_kind = loaded.info.format;
     let file_wrap = loaded.info.wrap;
     let mut notes = loaded.info.notes.clone();
+    // Said once per file, whatever the output (a 16-bit grey height map
+    // read as sRGB changes every value of a linear output).
+    if s.color == ColorChoice::Auto && !s.normal_map {
+        notes.extend(io::assumed_color_note(
+            &loaded.info,
+            &loaded.base().format(),
+        ));
+    }
     let channel_names = loaded.info.channel_names.clone();
     let mut base = loaded.into_base();
     // Interpretation of the input.
@@ -699,6 +760,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     let level_sizes = mip::level_sizes(base.width(), base.height(), s.rounding, s.levels);
     let (width, height) = (base.width(), base.height());
     let fingerprint = io::fingerprint(&base, &fingerprint_text(s, &options, &out_format, job.kind));
+    let block_format = s.compress.map(|(bf, _)| block_label(bf, out_format));
     let skipped = |status| Outcome {
         output: job.output.clone(),
         status,
@@ -711,6 +773,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         write_s: 0.0,
         notes: notes.clone(),
         blocks: None,
+        block_format: block_format.clone(),
     };
     if s.dry_run {
         return Ok(skipped(Status::DryRun));
@@ -806,6 +869,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
                         write_s: (t_build.elapsed().as_secs_f64() - build_s).max(0.0),
                         notes,
                         blocks: None,
+                        block_format: None,
                     });
                 }
                 None => st.into_base(),
@@ -904,12 +968,36 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         write_s,
         notes,
         blocks: blocks.map(|(_, r)| r),
+        block_format,
     })
 }
 
+/// The name of the block format `bf` stores levels of format `f` in
+/// (`BC7_SRGB` for sRGB colour, as the KTX2 and DDS formats name it).
+pub fn block_label(bf: BlockFormat, f: Format) -> String {
+    let alpha = f.has_alpha().then_some(f.alpha);
+    let want = crate::compress::input_format(bf, f.color_space, alpha);
+    let srgb = want.color_space == ColorSpace::Srgb;
+    format!("{bf}{}", if srgb { "_SRGB" } else { "" })
+}
+
+/// The first level WebGL refuses to take as a block-compressed level:
+/// WEBGL_compressed_texture_s3tc (revision 6, as its RGTC and BPTC
+/// siblings) requires `width << level` and `height << level` to be
+/// multiples of 4 — level 0's sides multiples of 4, level 1's even, any
+/// later level (earlier revisions asked every level for 1, 2 or a multiple
+/// of 4, which rejected the level 1 of a 1004-texel level 0).
+fn webgl_misfit(sizes: &[(u32, u32)]) -> Option<(usize, (u32, u32))> {
+    let ok = |n: u32, k: usize| k >= 2 || (n << k).is_multiple_of(4);
+    sizes
+        .iter()
+        .enumerate()
+        .find(|&(k, &(w, h))| !ok(w, k) || !ok(h, k))
+        .map(|(k, &s)| (k, s))
+}
+
 /// What a block format does to this source that the user should hear of:
-/// channels it drops or changes, and levels that are not block-aligned
-/// (WebGL requires every BC level's sides to be 1, 2 or a multiple of 4).
+/// channels it drops or changes, and levels WebGL refuses ([`webgl_misfit`]).
 fn compress_notes(bf: BlockFormat, src: Format, sizes: &[(u32, u32)]) -> Vec<String> {
     let mut notes = Vec::new();
     let ch = src.channels;
@@ -936,15 +1024,11 @@ fn compress_notes(bf: BlockFormat, src: Format, sizes: &[(u32, u32)]) -> Vec<Str
     if matches!(bf, BlockFormat::Bc6h { .. }) && !src.channel_type.is_float() {
         notes.push("BC6H is an HDR format; this input is not float (bc7 stores 8-bit colour in the same size)".into());
     }
-    let ok = |n: u32| n <= 2 || n.is_multiple_of(4);
-    if let Some((k, &(w, h))) = sizes
-        .iter()
-        .enumerate()
-        .find(|(_, (w, h))| !ok(*w) || !ok(*h))
-    {
+    if let Some((k, (w, h))) = webgl_misfit(sizes) {
         notes.push(format!(
-            "level {k} is {w}x{h}: block-compressed levels whose sides are not 1, 2 or a multiple of 4 \
-             are refused by WebGL; --resize-to pow2 keeps every level block-aligned"
+            "level {k} is {w}x{h}: WebGL refuses block-compressed levels unless level 0's sides are \
+             multiples of 4 (and level k's sides times 2^k are); --resize-to multiple-of-4 makes \
+             them so"
         ));
     }
     notes
@@ -1063,7 +1147,7 @@ fn encode_chain(
             height: first.height(),
             levels: data,
         };
-        let stored = format!("{bf}{}", if srgb { "_SRGB" } else { "" });
+        let stored = block_label(bf, f0);
         Ok((
             chain,
             BlockReport {
@@ -2081,6 +2165,21 @@ fn f32_to_f16(l: &Texture, f: Format) -> Result<Texture> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn webgl_takes_levels_whose_sides_shifted_by_the_level_are_multiples_of_4() {
+        let sizes = |w, h| mip::level_sizes(w, h, Rounding::Down, None);
+        // Level 0 a multiple of 4: every level is fine (1004 -> 502 -> 251 ...).
+        assert_eq!(webgl_misfit(&sizes(1004, 1000)), None);
+        assert_eq!(webgl_misfit(&sizes(4, 4)), None);
+        // Level 0 not whole blocks.
+        assert_eq!(webgl_misfit(&sizes(1001, 1000)), Some((0, (1001, 1000))));
+        assert_eq!(webgl_misfit(&sizes(2, 2)), Some((0, (2, 2))));
+        // Level 1 odd (rounded up from a multiple of 4 it never is; an
+        // explicit list can hold one).
+        assert_eq!(webgl_misfit(&[(12, 12), (7, 6)]), Some((1, (7, 6))));
+        assert_eq!(webgl_misfit(&[(12, 12), (6, 6), (3, 3), (1, 1)]), None);
+    }
 
     fn rgba8(w: u32, h: u32) -> Texture {
         let v = (0..w as usize * h as usize * 4)

@@ -70,8 +70,15 @@ impl TextureStore {
     /// [`crate::io::load`]) under `limits`: the file's own mip levels are
     /// the chain, and its wrap mode (repeat when it records none) is the
     /// one mips are built and filters sample with.
+    /// Non-finite float values are refused
+    /// ([`crate::io::LoadOptions::for_sampling`]).
     pub fn load(name: &str, limits: &crate::io::Limits) -> Result<Self> {
-        let loaded = crate::io::load(name, limits)?;
+        let loaded = crate::io::load_with(name, limits, &crate::io::LoadOptions::for_sampling())?;
+        Ok(Self::from_loaded(loaded))
+    }
+
+    /// A store of a loaded file (see [`TextureStore::load`]).
+    pub fn from_loaded(loaded: crate::io::Loaded) -> Self {
         let wrap = loaded.info.wrap.unwrap_or_default();
         let mut s = Self::from_levels(
             loaded.levels,
@@ -81,7 +88,7 @@ impl TextureStore {
             },
         );
         s.blocks = loaded.info.blocks;
-        Ok(s)
+        s
     }
 
     /// The block format of a block-compressed file the store was loaded

@@ -20,7 +20,6 @@ use anyhow::{Context, Result, anyhow, bail};
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 
-use parvo::MipChain;
 use parvo::cache::layout::{ChainLayout, Layout};
 use parvo::cache::run::{RunStats, SceneSetup, read_trace, unpack, write_trace_line};
 use parvo::cache::sim::{AddressSpace, CacheConfig, Counters, Simulator, parse_size};
@@ -53,6 +52,9 @@ pub struct CachesimArgs {
     /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
     #[arg(long, default_value = "builtin:checker:1024", value_name = "TEXTURE")]
     texture: String,
+
+    #[command(flatten)]
+    read: super::texture::TextureArgs,
     /// Filter: nearest, bilinear, bilinear-nomip, trilinear, aniso, anisoN, ewa, sat, supersample.
     #[arg(long, default_value = "trilinear", value_name = "F")]
     filter: String,
@@ -170,7 +172,7 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         Ok(o) => o,
         Err(e) => return usage(format!("{e:#}")),
     };
-    let (chain, blocks) = load(&args.texture)?;
+    let (chain, blocks) = args.read.load_chain(&args.texture)?;
     let sampler = Sampler::new(&chain, options)?;
     let layout = ChainLayout::for_sampler_stored(&chain, &sampler, args.layout, blocks);
     let setup = SceneSetup {
@@ -272,13 +274,6 @@ fn sampler_options(args: &CachesimArgs, name: &str) -> Result<SamplerOptions> {
     }
     o.validate()?;
     Ok(o)
-}
-
-/// The texture's chain (its own levels, or built), and the block format a
-/// block-compressed file stores (its traffic counts whole blocks).
-fn load(texture: &str) -> Result<(MipChain, Option<parvo::compress::BlockFormat>)> {
-    parvo::io::load_chain_stored(texture, &parvo::io::Limits::default())
-        .with_context(|| format!("cannot read texture `{texture}`"))
 }
 
 fn progress_bar(args: &CachesimArgs) -> Result<Option<ProgressBar>> {
@@ -542,7 +537,7 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
         }
     }
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let (chain, blocks) = load(&args.texture)?;
+    let (chain, blocks) = args.read.load_chain(&args.texture)?;
     let total = (filters.len() * args.layouts.len() * caches.len()) as u64;
     let bar = progress_bar(args)?;
     if let Some(b) = &bar {

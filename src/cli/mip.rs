@@ -151,16 +151,16 @@ pub enum ExtArg {
     Mitchell, triangle, odd sizes; 8.2 measured at 16384x16384: the source is freed before the \
     smaller levels are made); RGBA8 -> half .ktx2/.dds: 14.7 (box), 18.7 (the others). Alpha \
     coverage, normal maps, and float inputs holding NaN/Inf or written to 8/16-bit types build \
-    whole: add level 0 in f32 (4 bytes per channel). An output of the input's own type is built \
-    in that type (the box filter without f32 copies; the other filters decode the level they \
-    reduce to f32). --stats prints the peak and the time of each phase (for .exr, where building \
+    whole: add level 0 in f32 (4 bytes per channel). An output of the input's own type keeps \
+    the input as level 0 and reduces every later level from the unrounded one before it, in f32: \
+    add level 1 in f32 (a quarter of 4 bytes per channel). --stats prints the peak and the time of each phase (for .exr, where building \
     and writing interleave, build is the time spent making levels and write the rest; read \
     includes mapping the pages of levels 1-4 on the core a one-thread decoder such as PNG's leaves \
     idle).\n\n\
     Exit codes: 0 every input succeeded; 1 some input failed (the others were written); 2 usage error."
 )]
 pub struct MipArgs {
-    /// Input images (PNG, JPEG, TIFF, HDR, EXR, KTX2, DDS) or builtin:NAME[:SIZE].
+    /// Input images (PNG, JPEG, TIFF, HDR, EXR, KTX2, DDS), directories of them, or builtin:NAME[:SIZE].
     #[arg(required = true, value_name = "INPUT")]
     inputs: Vec<String>,
 
@@ -358,9 +358,10 @@ pub struct MipArgs {
         value_enum,
         value_name = "RULE",
         long_help = "Resample level 0 before building the chain, with the --filter kernel: \
-        multiple-of-4 rounds each side up to whole 4x4 blocks; pow2 takes each side to the nearest \
-        power of two (ties up), so every level of the chain stays block-aligned, as WebGL requires for \
-        block-compressed textures."
+        multiple-of-4 rounds each side up to whole 4x4 blocks, which is what WebGL requires of a \
+        block-compressed texture (level 0's sides multiples of 4; each level k's sides times 2^k \
+        multiples of 4, which levels rounded down from such a level 0 always are); pow2 takes each \
+        side to the nearest power of two (ties up), so that every level is whole blocks too."
     )]
     resize_to: Option<ResizeArg>,
 
@@ -501,6 +502,9 @@ fn settings(args: &MipArgs) -> Settings {
             channels: args.channels.clone(),
             subimage: args.subimage,
             auto_orient: !args.no_auto_orient,
+            // The colour choice and the NaN policy are the build's
+            // (Settings::color, Settings::nan_policy).
+            ..io::LoadOptions::default()
         },
         limits: Limits {
             max_width: args.max_width,
@@ -595,20 +599,38 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
             .num_threads(n)
             .build_global();
     }
+    // A directory among the inputs stands for the images in it.
+    let inputs = match pipeline::expand_inputs(&args.inputs) {
+        Ok(i) => i,
+        Err(e) => return usage(e.to_string()),
+    };
     let jobs = match (&args.output, &args.out_dir) {
         (Some(out), None) => {
-            if args.inputs.len() != 1 {
+            if inputs.len() != 1 {
                 return usage(format!(
                     "-o takes one input, got {}; use --out-dir DIR for a batch",
-                    args.inputs.len()
+                    inputs.len()
                 ));
             }
-            match Job::new(&args.inputs[0], out) {
+            match Job::new(&inputs[0], out) {
                 Ok(j) => vec![j],
                 Err(e) => return usage(e.to_string()),
             }
         }
-        (None, Some(dir)) => Job::batch(&args.inputs, dir, args.ext.into()),
+        (None, Some(dir)) => {
+            // Made when missing (not by a dry run, which writes nothing).
+            if !args.dry_run
+                && !dir.is_dir()
+                && let Err(e) = std::fs::create_dir_all(dir)
+            {
+                eprintln!(
+                    "parvo: cannot create the output directory {}: {e}",
+                    dir.display()
+                );
+                return Ok(ExitCode::from(1));
+            }
+            Job::batch(&inputs, dir, args.ext.into())
+        }
         _ => return usage("give -o OUTPUT (one input) or --out-dir DIR (a batch)".into()),
     };
     let mut settings = settings(&args);
@@ -696,7 +718,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
             }
             Err(e) => {
                 *failed.lock().unwrap_or_else(|e| e.into_inner()) += 1;
-                let msg = e.to_string().replace('\n', " ");
+                let msg = super::error_text(&e).replace('\n', " ");
                 warn(format!("parvo: {}: {msg}", job.input));
                 if args.json {
                     line(
@@ -755,7 +777,17 @@ fn summary_line(job: &Job, o: &Outcome, args: &MipArgs, secs: f64) -> String {
                 o.format
             )
         }
-        None => o.format.to_string(),
+        // Not encoded by this run (up to date, dry run): what the output
+        // holds, not the texels the encoder would read.
+        None => match (&o.block_format, &args.compress) {
+            (Some(bf), Some(_)) => format!(
+                "{bf} ({} quality)",
+                args.quality
+                    .to_possible_value()
+                    .map_or(String::new(), |v| v.get_name().to_string())
+            ),
+            _ => o.format.to_string(),
+        },
     };
     let sc = match (args.zstd, args.zlib) {
         (Some(l), _) => format!(", zstd {l}"),
@@ -829,6 +861,7 @@ fn json_line(job: &Job, o: &Outcome, secs: f64) -> String {
             "write": o.write_s,
         },
         "peak_rss_bytes": peak_rss_bytes(),
+        "block_format": o.block_format,
         "compression": o.blocks.as_ref().map(|b| serde_json::json!({
             "format": b.stored,
             "quality": b.quality.name(),

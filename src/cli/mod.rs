@@ -12,6 +12,7 @@ mod info;
 mod mip;
 mod render;
 mod sample;
+mod texture;
 mod tradeoff;
 
 /// Texture filtering and mipmap processing.
@@ -33,6 +34,26 @@ enum Command {
     Cachesim(Box<cachesim::CachesimArgs>),
     Render(render::RenderArgs),
     Tradeoff(Box<tradeoff::TradeoffArgs>),
+}
+
+/// The CLI's words for a library error: the error and, where a flag
+/// deals with it, that flag.
+pub(crate) fn error_text(e: &parvo::Error) -> String {
+    let hint = match e {
+        parvo::Error::NonFinite { .. } => {
+            Some("--fixnan black or --fixnan neighbors replaces such values")
+        }
+        _ => None,
+    };
+    match hint {
+        Some(h) => format!("{e} ({h})"),
+        None => e.to_string(),
+    }
+}
+
+/// [`error_text`] as an error of the CLI.
+pub(crate) fn with_hint(e: parvo::Error) -> anyhow::Error {
+    anyhow::anyhow!(error_text(&e))
 }
 
 /// Progress bar templates: a count of steps, and a percentage.

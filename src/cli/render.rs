@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use parvo::sample::SamplerOptions;
 use parvo::scene::reference::{PixelFilter, Reference};
@@ -31,6 +31,9 @@ pub struct RenderArgs {
     /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
     #[arg(long, default_value = "builtin:zoneplate:512", value_name = "TEXTURE")]
     texture: String,
+
+    #[command(flatten)]
+    read: super::texture::TextureArgs,
     /// Filter (nearest, bilinear, bilinear-nomip, trilinear, anisoN, ewa, sat, supersample) or reference.
     #[arg(long, default_value = "trilinear", value_name = "F")]
     filter: String,
@@ -100,8 +103,7 @@ fn shade(args: &RenderArgs, brdf: ShadeBrdf) -> Result<ExitCode> {
         );
         return Ok(ExitCode::from(2));
     };
-    let loaded = parvo::io::load(&args.texture, &parvo::io::Limits::default())
-        .with_context(|| format!("cannot read texture `{}`", args.texture))?;
+    let loaded = args.read.load(&args.texture)?;
     let mut n = loaded.into_base();
     // A normal map holds vectors: read its codes as they are stored.
     let mut f = n.format();
@@ -137,8 +139,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     if let Some(b) = args.shade {
         return shade(&args, b);
     }
-    let store = TextureStore::load(&args.texture, &parvo::io::Limits::default())
-        .with_context(|| format!("cannot read texture `{}`", args.texture))?;
+    let store = TextureStore::from_loaded(args.read.load(&args.texture)?);
     let wrap = store.options().wrap;
     let base = store.base();
     let tex = (base.width(), base.height());

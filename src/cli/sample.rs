@@ -17,8 +17,8 @@ use std::io::{self, BufRead, BufWriter, Write};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
+use parvo::Wrap;
 use parvo::sample::{Filter, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
-use parvo::{MipChain, Wrap};
 
 /// Queries parsed and sampled per batch.
 const CHUNK: usize = 1 << 16;
@@ -36,6 +36,10 @@ pub struct SampleArgs {
     /// Texture: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE], or a file `parvo mip` reads.
     #[arg(value_name = "TEXTURE")]
     texture: String,
+
+    #[command(flatten)]
+    read: super::texture::TextureArgs,
+
     /// Filter preset: nearest, bilinear, trilinear, aniso, ewa, sat, supersample.
     #[arg(long, default_value = "trilinear", value_name = "F")]
     filter: Filter,
@@ -129,23 +133,15 @@ impl SampleArgs {
     }
 }
 
-/// Load `spec` as a mip chain. All texture loading of this command lives
-/// here: a mip-mapped file keeps its own levels, a plain image gets box
-/// mips built on load.
-fn load_chain(spec: &str) -> Result<MipChain> {
-    // A mip-mapped EXR/KTX2/DDS keeps its own levels; anything else gets
-    // box mips built on load (`parvo::io::load_chain`).
-    parvo::io::load_chain(spec, &parvo::io::Limits::default())
-        .with_context(|| format!("cannot read texture `{spec}`"))
-}
-
 pub fn run(args: SampleArgs) -> Result<ExitCode> {
     let mut options = args.options();
     if let Err(e) = options.validate() {
         eprintln!("parvo: {e}");
         return Ok(ExitCode::from(2));
     }
-    let chain = load_chain(&args.texture)?;
+    // A mip-mapped EXR/KTX2/DDS keeps its own levels; anything else gets
+    // box mips built on load.
+    let (chain, _) = args.read.load_chain(&args.texture)?;
     if args.wrap.is_none() {
         // The wrap modes the file records (EXR/TIFF `wrapmodes`, parvo's
         // KTX2 key), as OpenImageIO's texture system uses them; repeat when

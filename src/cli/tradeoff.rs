@@ -61,6 +61,9 @@ pub struct TradeoffArgs {
     /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
     #[arg(long, default_value = "builtin:zoneplate:512", value_name = "TEXTURE")]
     texture: String,
+
+    #[command(flatten)]
+    read: super::texture::TextureArgs,
     /// Filters by report name.
     #[arg(
         long,
@@ -310,8 +313,7 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
         }
         reference.samples_per_texel = s;
     }
-    let store = TextureStore::load(&args.texture, &parvo::io::Limits::default())
-        .with_context(|| format!("cannot read texture `{}`", args.texture))?;
+    let store = TextureStore::from_loaded(args.read.load(&args.texture)?);
     let wrap = store.options().wrap;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;

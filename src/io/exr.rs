@@ -1129,6 +1129,8 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         attributes,
         notes,
         blocks: None,
+        // OpenEXR stores linear values by definition.
+        color_stated: true,
     };
     Ok(Loaded { levels, info })
 }

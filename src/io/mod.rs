@@ -32,7 +32,7 @@ use std::path::Path;
 use half::slice::HalfFloatSliceExt;
 
 use crate::error::{Error, Result};
-use crate::mip::{self, MipChain, MipOptions, Rounding};
+use crate::mip::{self, MipChain, MipOptions, NanPolicy, Rounding};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::Wrap;
@@ -107,6 +107,12 @@ pub struct SourceInfo {
     /// The block format the file stores its levels in (decoded on load),
     /// if it is block-compressed.
     pub blocks: Option<crate::compress::BlockFormat>,
+    /// False when the file says nothing about how its colour values are
+    /// encoded and the colour space is parvo's assumption (OpenImageIO's
+    /// reading): a PNG without `sRGB`, `cICP`, `gAMA` or `iCCP` chunk is
+    /// read as sRGB, a TIFF as linear. True otherwise (by the format's
+    /// definition or the file's own statement).
+    pub color_stated: bool,
 }
 
 impl SourceInfo {
@@ -121,6 +127,7 @@ impl SourceInfo {
             attributes: Vec::new(),
             notes: Vec::new(),
             blocks: None,
+            color_stated: true,
         }
     }
 
@@ -168,6 +175,46 @@ impl Loaded {
     pub fn into_base(mut self) -> Texture {
         self.levels.swap_remove(0)
     }
+
+    /// Consume into a mip chain: the file's own levels when it stores
+    /// them, otherwise a box-filtered chain built from level 0 (wrap modes
+    /// from the file when it names them, else repeat); and the block
+    /// format the file stored its levels in, if any.
+    pub fn into_chain(self) -> Result<(MipChain, Option<crate::compress::BlockFormat>)> {
+        let blocks = self.info.blocks;
+        let options = MipOptions {
+            rounding: self.info.rounding,
+            wrap: self.info.wrap.unwrap_or_default(),
+            ..MipOptions::default()
+        };
+        let chain = if self.levels.len() > 1 {
+            MipChain::from_levels(self.levels, options)?
+        } else {
+            mip::build(self.into_base(), &options)?
+        };
+        Ok((chain, blocks))
+    }
+}
+
+/// When the colour space of a source with texels `f` is parvo's
+/// assumption ([`SourceInfo::color_stated`]) and integer data is read by
+/// it, the sentence that says so (the CLI prints it once per file).
+pub fn assumed_color_note(info: &SourceInfo, f: &Format) -> Option<String> {
+    if info.color_stated || f.channel_type.is_float() {
+        return None;
+    }
+    Some(match f.color_space {
+        ColorSpace::Srgb => format!(
+            "the {} file does not say how its values encode colour: read as sRGB-encoded colour, \
+             as OpenImageIO reads such files (--color linear reads them as data, e.g. a height map)",
+            info.format
+        ),
+        ColorSpace::Linear => format!(
+            "the {} file does not say how its values encode colour: read as linear values, as \
+             OpenImageIO reads such files (--color srgb decodes them as sRGB)",
+            info.format
+        ),
+    })
 }
 
 /// A recorded `wrapmodes` text as wrap modes; one that does not parse is
@@ -198,6 +245,29 @@ pub struct LoadOptions {
     /// Rotate JPEG and TIFF images by their EXIF orientation, as image
     /// viewers and `oiiotool --autoorient` do. Default: true.
     pub auto_orient: bool,
+    /// Read the colour channels as this colour space whatever the file
+    /// says or does not say; `None` (the default) reads them as the file
+    /// says (see the module docs; [`SourceInfo::color_stated`] tells when
+    /// that is parvo's assumption).
+    pub color: Option<ColorSpace>,
+    /// Apply this policy to non-finite values (NaN, ±Inf) in every level
+    /// of float data as it is loaded; `None` (the default) leaves them for
+    /// the caller (`mip::build` applies its own [`MipOptions::nan_policy`]
+    /// while it builds). [`LoadOptions::for_sampling`] sets
+    /// [`NanPolicy::Error`].
+    pub nan_policy: Option<NanPolicy>,
+}
+
+impl LoadOptions {
+    /// The options of a load whose levels are sampled as they are: the
+    /// file's colour space, and non-finite values refused
+    /// ([`NanPolicy::Error`]), as `mip::build` refuses them.
+    pub fn for_sampling() -> Self {
+        LoadOptions {
+            nan_policy: Some(NanPolicy::Error),
+            ..Default::default()
+        }
+    }
 }
 
 impl Default for LoadOptions {
@@ -206,6 +276,8 @@ impl Default for LoadOptions {
             channels: None,
             subimage: 0,
             auto_orient: true,
+            color: None,
+            nan_policy: None,
         }
     }
 }
@@ -232,6 +304,49 @@ pub type Overlap<'a> = &'a mut (dyn FnMut(u32, u32, u8, ChannelType) + Send);
 /// never call it. A caller uses it to allocate and fault in the buffers
 /// it will fill next, off the critical path.
 pub fn load_overlapped(
+    spec: &str,
+    limits: &Limits,
+    options: &LoadOptions,
+    overlap: Option<Overlap<'_>>,
+) -> Result<Loaded> {
+    let mut loaded = load_stored(spec, limits, options, overlap)?;
+    if let Some(cs) = options.color {
+        loaded.levels = std::mem::take(&mut loaded.levels)
+            .into_iter()
+            .map(|l| {
+                let f = Format {
+                    color_space: cs,
+                    ..l.format()
+                };
+                l.reinterpret(f)
+            })
+            .collect::<Result<_>>()?;
+    }
+    if let Some(policy) = options.nan_policy {
+        for (k, l) in loaded.levels.iter_mut().enumerate() {
+            crate::mip::nan::apply(l, policy).map_err(|e| match e {
+                Error::NonFinite {
+                    x,
+                    y,
+                    channel,
+                    value,
+                    ..
+                } => Error::NonFinite {
+                    level: k as u32,
+                    x,
+                    y,
+                    channel,
+                    value,
+                },
+                other => other,
+            })?;
+        }
+    }
+    Ok(loaded)
+}
+
+/// The texels as the file stores them (see [`load_overlapped`]).
+fn load_stored(
     spec: &str,
     limits: &Limits,
     options: &LoadOptions,
@@ -320,29 +435,20 @@ pub fn load_overlapped(
 /// Load a texture as a mip chain: the file's own levels when it stores them
 /// (EXR, KTX2, DDS), otherwise a box-filtered chain built from level 0
 /// (wrap modes from the file when it names them, else repeat).
+/// Non-finite values in float data are refused
+/// ([`LoadOptions::for_sampling`]).
 pub fn load_chain(spec: &str, limits: &Limits) -> Result<MipChain> {
-    load_chain_stored(spec, limits).map(|c| c.0)
+    load_chain_stored(spec, limits, &LoadOptions::for_sampling()).map(|c| c.0)
 }
 
-/// [`load_chain`], and the block format a block-compressed file stores its
-/// levels in (they are decoded), if any.
+/// [`load_chain`] with [`LoadOptions`], and the block format a
+/// block-compressed file stores its levels in (they are decoded), if any.
 pub fn load_chain_stored(
     spec: &str,
     limits: &Limits,
+    options: &LoadOptions,
 ) -> Result<(MipChain, Option<crate::compress::BlockFormat>)> {
-    let loaded = load(spec, limits)?;
-    let blocks = loaded.info.blocks;
-    let options = MipOptions {
-        rounding: loaded.info.rounding,
-        wrap: loaded.info.wrap.unwrap_or_default(),
-        ..MipOptions::default()
-    };
-    let chain = if loaded.levels.len() > 1 {
-        MipChain::from_levels(loaded.levels, options)?
-    } else {
-        mip::build(loaded.into_base(), &options)?
-    };
-    Ok((chain, blocks))
+    load_with(spec, limits, options)?.into_chain()
 }
 
 /// The colour transfer a PNG's chunks declare, as OpenImageIO reads them:
@@ -350,7 +456,7 @@ pub fn load_chain_stored(
 /// (1.0 linear, 1/2.2 sRGB, other exponents sRGB with a note); an `iCCP`
 /// profile is not interpreted (sRGB, with a note unless it names sRGB); no
 /// chunk at all means sRGB, at any bit depth.
-fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>)> {
+fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>, bool)> {
     let file = std::fs::File::open(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         action: "cannot open".into(),
@@ -364,24 +470,25 @@ fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>)> {
         })?;
     let info = reader.info();
     if info.srgb.is_some() {
-        return Ok((ColorSpace::Srgb, None));
+        return Ok((ColorSpace::Srgb, None, true));
     }
     if let Some(c) = &info.coding_independent_code_points {
         return Ok(match c.transfer_function {
-            13 => (ColorSpace::Srgb, None),
-            8 => (ColorSpace::Linear, None),
+            13 => (ColorSpace::Srgb, None, true),
+            8 => (ColorSpace::Linear, None, true),
             t => (
                 ColorSpace::Srgb,
                 Some(format!(
                     "cICP transfer characteristics {t} is neither sRGB (13) nor linear (8): read as sRGB"
                 )),
+                true,
             ),
         });
     }
     if let Some(g) = info.gama_chunk {
         let gamma = g.into_value() as f64;
         if (gamma - 1.0).abs() < 0.01 {
-            return Ok((ColorSpace::Linear, None));
+            return Ok((ColorSpace::Linear, None, true));
         }
         let note = ((1.0 / gamma - 2.2).abs() > 0.05).then(|| {
             format!(
@@ -389,16 +496,18 @@ fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>)> {
                 1.0 / gamma
             )
         });
-        return Ok((ColorSpace::Srgb, note));
+        return Ok((ColorSpace::Srgb, note, true));
     }
     if let Some(icc) = &info.icc_profile {
         let names_srgb = icc.windows(4).any(|w| w == b"sRGB");
         return Ok((
             ColorSpace::Srgb,
             (!names_srgb).then(|| "the ICC profile is not interpreted: read as sRGB".to_string()),
+            true,
         ));
     }
-    Ok((ColorSpace::Srgb, None))
+    // Nothing said: OpenImageIO's reading, marked as an assumption.
+    Ok((ColorSpace::Srgb, None, false))
 }
 
 fn load_image(
@@ -432,9 +541,11 @@ fn load_image(
         }
     };
     let mut notes = Vec::new();
+    let mut color_stated = true;
     let png_cs = if file_format == FileFormat::Png {
-        let (cs, note) = png_transfer(path)?;
+        let (cs, note, stated) = png_transfer(path)?;
         notes.extend(note);
+        color_stated = stated;
         Some(cs)
     } else {
         None
@@ -556,6 +667,7 @@ fn load_image(
     let mut info = SourceInfo::new(file_format, &tex.format());
     info.attributes = attributes;
     info.notes = notes;
+    info.color_stated = color_stated;
     Ok(Loaded {
         levels: vec![tex],
         info,

@@ -65,6 +65,7 @@ pub fn check(tex: &Texture) -> Result<()> {
     match at {
         None => Ok(()),
         Some((i, value)) => Err(Error::NonFinite {
+            level: 0,
             x: ((i / ch) % w) as u32,
             y: ((i / ch) / w) as u32,
             channel: (i % ch) as u8,
@@ -143,6 +144,7 @@ fn fix(
         NanPolicy::Error => {
             let t = first / ch;
             Err(Error::NonFinite {
+                level: 0,
                 x: (t % w) as u32,
                 y: (t / w) as u32,
                 channel: (first % ch) as u8,

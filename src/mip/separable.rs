@@ -75,7 +75,12 @@ pub fn reduce_linear(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Vec
 }
 
 /// [`reduce_linear`], and whether every value is finite.
-pub(crate) fn reduce_linear_checked(src: &Texture, w: u32, h: u32, options: &MipOptions) -> (Vec<f32>, bool) {
+pub(crate) fn reduce_linear_checked(
+    src: &Texture,
+    w: u32,
+    h: u32,
+    options: &MipOptions,
+) -> (Vec<f32>, bool) {
     use std::sync::atomic::{AtomicBool, Ordering};
     let finite = AtomicBool::new(true);
     let fmt = src.format();

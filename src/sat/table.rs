@@ -256,6 +256,7 @@ fn first_non_finite(tex: &Texture) -> Result<()> {
     };
     match bad {
         Some((i, value)) => Err(Error::NonFinite {
+            level: 0,
             x: ((i / ch) % w) as u32,
             y: (i / ch / w) as u32,
             channel: (i % ch) as u8,

@@ -285,10 +285,60 @@ pub fn reference_reduce(
     wrap_u: &str,
     wrap_v: &str,
 ) -> Vec<f64> {
-    let f = src.format();
-    let ch = f.channels as usize;
     let (sw, sh) = (src.width() as usize, src.height() as usize);
     let lin = decode(src);
+    reference_reduce_linear(
+        &lin,
+        src.format(),
+        (sw, sh),
+        (dw, dh),
+        filter,
+        wrap_u,
+        wrap_v,
+    )
+}
+
+/// The reference chain: levels 1.. (linear values, as [`reference_reduce`]
+/// gives), each reduced from the unrounded level before it, with the sizes
+/// of `sizes` (level 0's first).
+pub fn reference_chain(
+    base: &Texture,
+    sizes: &[(u32, u32)],
+    filter: &str,
+    wrap_u: &str,
+    wrap_v: &str,
+) -> Vec<Vec<f64>> {
+    let f = base.format();
+    let mut prev = decode(base);
+    let mut out = Vec::new();
+    for p in sizes.windows(2) {
+        let (s, d) = (p[0], p[1]);
+        let next = reference_reduce_linear(
+            &prev,
+            f,
+            (s.0 as usize, s.1 as usize),
+            (d.0 as usize, d.1 as usize),
+            filter,
+            wrap_u,
+            wrap_v,
+        );
+        out.push(next.clone());
+        prev = next;
+    }
+    out
+}
+
+/// [`reference_reduce`] of linear values `lin` (`sw·sh` texels of `f`).
+pub fn reference_reduce_linear(
+    lin: &[f64],
+    f: Format,
+    (sw, sh): (usize, usize),
+    (dw, dh): (usize, usize),
+    filter: &str,
+    wrap_u: &str,
+    wrap_v: &str,
+) -> Vec<f64> {
+    let ch = f.channels as usize;
     let wx = axis_weights(filter, sw, dw, wrap_u);
     let wy = axis_weights(filter, sh, dh, wrap_v);
     let alpha = (f.alpha == AlphaMode::Straight && (ch == 2 || ch == 4)).then_some(ch - 1);

@@ -210,7 +210,11 @@ fn cli_eight_bit_chains_round_once() {
                 .map(|l| {
                     assert_eq!(
                         l.format().color_space,
-                        if srgb { ColorSpace::Srgb } else { ColorSpace::Linear }
+                        if srgb {
+                            ColorSpace::Srgb
+                        } else {
+                            ColorSpace::Linear
+                        }
                     );
                     codes(l.texels())
                 })

@@ -5,6 +5,8 @@
 mod util;
 
 mod alpha_coverage_bound_broken_by_8bit_rounding;
+mod batch_ergonomics;
+mod colour_assumption_silent_and_no_color_for_sampling;
 mod compress_batch_hangs;
 mod dds_headers_pillow_read_as_black;
 mod eight_bit_chains_drift;
@@ -24,6 +26,7 @@ mod multipart_and_multipage_silently_first;
 mod normal_maps_filtered_as_encoded_codes;
 mod png_colour_chunks_ignored;
 mod premultiplied_exr_written_premultiplied_to_png;
+mod readme_said_built_fuzz_targets_were_missing;
 mod roughness_map_ringing_went_below_zero;
 mod rounding_up_writes_invalid_ktx2;
 mod sample_ignores_recorded_wrap_modes;

@@ -16,10 +16,7 @@ pub fn bin() -> std::path::PathBuf {
 }
 
 pub fn parvo(args: &[&str]) -> Output {
-    Command::new(bin())
-        .args(args)
-        .output()
-        .expect("run parvo")
+    Command::new(bin()).args(args).output().expect("run parvo")
 }
 
 pub fn parvo_stdin(args: &[&str], stdin: &str) -> Output {

@@ -1,0 +1,80 @@
+//! The texture a sampling command reads (`sample`, `render`, `tradeoff`,
+//! `cachesim`): `--color` and `--fixnan` as `parvo mip` has them, so that a
+//! file is read the same way by every command, and what the loader
+//! assumed or chose said on stderr once, as `parvo mip` says it.
+
+use anyhow::{Context, Result};
+
+use parvo::MipChain;
+use parvo::compress::BlockFormat;
+use parvo::io::{self, Limits, LoadOptions, Loaded};
+use parvo::mip::NanPolicy;
+use parvo::texel::ColorSpace;
+
+use super::mip::ColorArg;
+
+/// How to read the texture file.
+#[derive(clap::Args, Debug, Clone)]
+pub struct TextureArgs {
+    /// How the file's colour values are encoded: auto, linear or srgb.
+    #[arg(
+        long,
+        default_value = "auto",
+        value_name = "SPACE",
+        long_help = "How the texture's colour values are encoded. auto: what the file says (PNG \
+        by its sRGB/cICP/gAMA chunks, sRGB when it has none, as OpenImageIO reads it; JPEG sRGB; \
+        KTX2 and DDS by their format; OpenEXR, TIFF and HDR linear). linear: the values are data or \
+        linear light, used as stored (a height map, a 16-bit data PNG that OpenImageIO wrote with \
+        an sRGB chunk). srgb: decode them as sRGB."
+    )]
+    pub color: ColorArg,
+
+    /// NaN/Inf in float texels: error, black or neighbors.
+    #[arg(
+        long,
+        default_value = "error",
+        value_name = "POLICY",
+        long_help = "Non-finite values (NaN, +Inf, -Inf) in a float texture, in any of its levels: \
+        error refuses the file naming the first one (as parvo mip does); black replaces each by 0; \
+        neighbors by the average of its finite neighbours."
+    )]
+    pub fixnan: NanPolicy,
+}
+
+impl TextureArgs {
+    /// The loader's options these arguments ask for.
+    pub fn options(&self) -> LoadOptions {
+        LoadOptions {
+            color: match self.color {
+                ColorArg::Auto => None,
+                ColorArg::Linear => Some(ColorSpace::Linear),
+                ColorArg::Srgb => Some(ColorSpace::Srgb),
+            },
+            nan_policy: Some(self.fixnan),
+            ..LoadOptions::default()
+        }
+    }
+
+    /// Load `spec`, printing the loader's notes (and its colour assumption
+    /// under `--color auto`) on stderr.
+    pub fn load(&self, spec: &str) -> Result<Loaded> {
+        let loaded = io::load_with(spec, &Limits::default(), &self.options())
+            .map_err(super::with_hint)
+            .with_context(|| format!("cannot read texture `{spec}`"))?;
+        let assumed = (self.color == ColorArg::Auto)
+            .then(|| io::assumed_color_note(&loaded.info, &loaded.base().format()))
+            .flatten();
+        for n in loaded.info.notes.iter().chain(&assumed) {
+            eprintln!("parvo: {spec}: {n}");
+        }
+        Ok(loaded)
+    }
+
+    /// [`Self::load`] as a mip chain: the file's own levels, or box mips
+    /// built on load; and the block format the file stores, if any.
+    pub fn load_chain(&self, spec: &str) -> Result<(MipChain, Option<BlockFormat>)> {
+        self.load(spec)?
+            .into_chain()
+            .with_context(|| format!("cannot read texture `{spec}`"))
+    }
+}
