@@ -127,6 +127,22 @@ fn bench_chains(c: &mut Criterion) {
             g.bench_function(BenchmarkId::new("parvo_box_rgba8_srgb", &t), |b| {
                 b.iter(|| run(&srgb8, MipFilter::Box))
             });
+            // Each level rounded to 8 bits and reduced from that (what
+            // parvo did before issue 27): the cost of rounding once.
+            g.bench_function(BenchmarkId::new("chained_box_rgba8_srgb", &t), |b| {
+                b.iter(|| {
+                    p.install(|| {
+                        let opts = MipOptions::default();
+                        let sizes = mip::level_sizes(n, n, opts.rounding, None);
+                        let (w1, h1) = sizes[1];
+                        let mut prev = mip::reduce(black_box(&srgb8), w1, h1, &opts).unwrap();
+                        for &(w, h) in &sizes[2..] {
+                            prev = mip::reduce(&prev, w, h, &opts).unwrap();
+                        }
+                        prev.width()
+                    })
+                })
+            });
             g.bench_function(BenchmarkId::new("parvo_box_rgba_f32", &t), |b| {
                 b.iter(|| run(&f32tex, MipFilter::Box))
             });

@@ -30,7 +30,7 @@ use rayon::prelude::*;
 
 use super::{MipFilter, MipOptions, srgb_simd};
 use crate::error::Result;
-use crate::texel::{AlphaMode, ColorSpace, Format, Texels, srgb};
+use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels, srgb};
 use crate::texture::Texture;
 
 /// Destination bytes per parallel task (keeps rayon overhead negligible).
@@ -74,16 +74,19 @@ pub fn try_reduce(
 
 /// The 2×2 box of an even-sized level of any stored type, to linear f32
 /// (the unrounded level a chain reduces further): each pair of source rows
-/// is decoded into per-thread scratch and reduced with [`box_row_f32`], so
-/// no decoded copy of the whole level exists. `None` when the box does not
-/// apply (another filter, or sizes that do not halve exactly). The flag is
-/// as [`try_reduce`]'s.
+/// is decoded into per-thread scratch (or read in place when the level is
+/// linear f32) and reduced with [`box_row_f32`], so no decoded copy of the
+/// whole level exists. With `encode` an 8-bit format, each new row is also
+/// encoded to it while in cache (the stored level: [`ReducedLinear::stored`]).
+/// `None` when the box does not apply (another filter, or sizes that do
+/// not halve exactly).
 pub fn try_reduce_linear(
     src: &Texture,
     w: u32,
     h: u32,
     options: &MipOptions,
-) -> Option<(Vec<f32>, bool)> {
+    encode: Option<Format>,
+) -> Option<ReducedLinear> {
     let (sw, sh) = (src.width() as usize, src.height() as usize);
     if options.filter != MipFilter::Box || sw != 2 * w as usize || sh != 2 * h as usize {
         return None;
@@ -92,32 +95,86 @@ pub fn try_reduce_linear(
     let straight = fmt
         .alpha_channel()
         .filter(|_| fmt.alpha == AlphaMode::Straight);
-    if let (Texels::F32(s), ColorSpace::Linear) = (src.texels(), fmt.color_space) {
-        return Some(box_f32(s, sw, fmt, straight));
-    }
     use std::sync::atomic::{AtomicBool, Ordering};
     let ch = fmt.channels as usize;
     let row = w as usize * ch;
     let src_row = sw * ch;
     let mut dst: Vec<f32> = crate::mem::zeroed(row * h as usize);
+    let encode = encode.filter(|f| f.channel_type == ChannelType::U8 && f.channels == fmt.channels);
+    let mut stored: Vec<u8> = match encode {
+        Some(_) => crate::mem::zeroed(row * h as usize),
+        None => Vec::new(),
+    };
     let per = rows_per_task(row * 4);
     let finite = AtomicBool::new(ch == 4);
     let texels = src.texels();
-    dst.par_chunks_mut(row * per).enumerate().for_each_init(
-        || vec![0f32; 2 * src_row],
-        |scratch, (task, out)| {
-            let (r0, r1) = scratch.split_at_mut(src_row);
+    let in_place = match (texels, fmt.color_space) {
+        (Texels::F32(v), ColorSpace::Linear) => Some(v.as_slice()),
+        _ => None,
+    };
+    let mut stored_tasks: Vec<&mut [u8]> = if encode.is_some() {
+        stored.chunks_mut(row * per).collect()
+    } else {
+        Vec::new()
+    };
+    type Task<'a> = (usize, (&'a mut [f32], Option<&'a mut [u8]>));
+    let tasks: Vec<Task<'_>> = dst
+        .chunks_mut(row * per)
+        .zip(
+            stored_tasks
+                .drain(..)
+                .map(Some)
+                .chain(std::iter::repeat_with(|| None)),
+        )
+        .enumerate()
+        .collect();
+    tasks.into_par_iter().for_each_init(
+        || vec![0f32; if in_place.is_some() { 0 } else { 2 * src_row }],
+        |scratch, (task, (out, mut coded))| {
             for (i, d) in out.chunks_exact_mut(row).enumerate() {
                 let y = task * per + i;
-                crate::texel::decode_range_to_linear(&fmt, texels, 2 * y * src_row, r0);
-                crate::texel::decode_range_to_linear(&fmt, texels, (2 * y + 1) * src_row, r1);
+                let (r0, r1): (&[f32], &[f32]) = match in_place {
+                    Some(v) => (
+                        &v[2 * y * src_row..][..src_row],
+                        &v[(2 * y + 1) * src_row..][..src_row],
+                    ),
+                    None => {
+                        let (r0, r1) = scratch.split_at_mut(src_row);
+                        crate::texel::decode_range_to_linear(&fmt, texels, 2 * y * src_row, r0);
+                        crate::texel::decode_range_to_linear(
+                            &fmt,
+                            texels,
+                            (2 * y + 1) * src_row,
+                            r1,
+                        );
+                        (r0, r1)
+                    }
+                };
                 if !box_row_f32(r0, r1, d, ch, straight) {
                     finite.store(false, Ordering::Relaxed);
+                }
+                if let (Some(f), Some(c)) = (&encode, coded.as_deref_mut()) {
+                    crate::texel::encode_u8(f, d, &mut c[i * row..][..row]);
                 }
             }
         },
     );
-    Some((dst, finite.into_inner()))
+    Some(ReducedLinear {
+        linear: dst,
+        stored: encode.map(|_| Texels::U8(stored)),
+        finite: finite.into_inner(),
+    })
+}
+
+/// What [`try_reduce_linear`] made.
+pub struct ReducedLinear {
+    /// The level in linear f32, unrounded.
+    pub linear: Vec<f32>,
+    /// The level encoded to the 8-bit format asked for, if any.
+    pub stored: Option<Texels>,
+    /// Every value came out finite (tracked by the RGBA kernel only;
+    /// `false` means "not known").
+    pub finite: bool,
 }
 
 fn rows_per_task(row_bytes: usize) -> usize {

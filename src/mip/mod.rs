@@ -29,6 +29,7 @@ pub mod normal;
 pub mod roughness;
 pub mod separable;
 mod srgb_simd;
+pub mod stream;
 pub mod weights;
 
 use std::fmt;
@@ -369,13 +370,36 @@ fn reduced_levels(
     let mut levels: Vec<Texture> = Vec::with_capacity(sizes.len().saturating_sub(1));
     // The unrounded last level, when it is not the stored one.
     let mut work: Option<Texture> = None;
-    for (k, &(w, h)) in sizes.iter().enumerate().skip(1) {
+    // Box levels made band by band first, where they apply (stream).
+    let m = stream::levels(sizes, options);
+    if m >= 1 {
+        let made = stream::box_levels(base, m, stored);
+        for (k, t) in made.stored.into_iter().enumerate() {
+            let (w, h) = sizes[k + 1];
+            levels.push(Texture::from_texels(w, h, stored, t)?);
+            if k == 0 && deferred && !made.finite {
+                nan::check_via_reduced(base, &levels[0])?;
+            }
+            done(k + 1, w as u64 * h as u64);
+        }
+        let (wm, hm) = sizes[m];
+        work = Some(Texture::from_f32(
+            wm,
+            hm,
+            working_format(stored),
+            made.last,
+        )?);
+    }
+    for (k, &(w, h)) in sizes.iter().enumerate().skip(m + 1) {
         let prev = match (&work, levels.last()) {
             (Some(t), _) => t,
             (None, Some(t)) => t,
             (None, None) => base,
         };
-        let (mut next, finite) = reduce_working(prev, w, h, options)?;
+        // The stored level comes with the reduction (8-bit box) unless
+        // alpha coverage must change the level first.
+        let encode = (separate && options.alpha_coverage.is_none()).then_some(stored);
+        let (mut next, coded, finite) = reduce_working(prev, w, h, options, encode)?;
         if let (Some(r), Some(c0)) = (options.alpha_coverage, coverage0) {
             let store = options.alpha_store.unwrap_or(stored.channel_type);
             alpha::preserve_coverage(&mut next, r, c0, store);
@@ -384,15 +408,23 @@ fn reduced_levels(
             nan::check_via_reduced(base, &next)?;
         }
         if separate {
-            let mut out = Texture::new(w, h, stored)?;
-            let Texels::F32(lin) = next.texels() else {
-                return Err(Error::InvalidOption("working levels are f32".into()));
+            let out = match coded {
+                Some(t) => Texture::from_texels(w, h, stored, t)?,
+                None => {
+                    let mut out = Texture::new(w, h, stored)?;
+                    let Texels::F32(lin) = next.texels() else {
+                        return Err(Error::InvalidOption("working levels are f32".into()));
+                    };
+                    crate::texel::encode_from_linear(&stored, lin, out.texels_mut());
+                    out
+                }
             };
-            crate::texel::encode_from_linear(&stored, lin, out.texels_mut());
             levels.push(out);
             work = Some(next);
         } else {
+            // The stored level is the working one.
             levels.push(next);
+            work = None;
         }
         done(k, w as u64 * h as u64);
     }
@@ -400,19 +432,30 @@ fn reduced_levels(
 }
 
 /// One reduction to `w × h` in the working form (see [`working_format`]),
-/// with the fast box where it applies; the flag says every value came out
-/// finite.
-fn reduce_working(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result<(Texture, bool)> {
+/// with the fast box where it applies; with `encode`, the level in that
+/// format too when the fast path made it on the way. The flag says every
+/// value came out finite.
+fn reduce_working(
+    src: &Texture,
+    w: u32,
+    h: u32,
+    options: &MipOptions,
+    encode: Option<Format>,
+) -> Result<(Texture, Option<Texels>, bool)> {
     let fast = options
         .fast_paths
-        .then(|| fast::try_reduce_linear(src, w, h, options))
+        .then(|| fast::try_reduce_linear(src, w, h, options, encode))
         .flatten();
-    let (v, finite) = match fast {
-        Some(r) => r,
-        None => separable::reduce_linear_checked(src, w, h, options),
+    let (v, coded, finite) = match fast {
+        Some(r) => (r.linear, r.stored, r.finite),
+        None => {
+            let (v, finite) = separable::reduce_linear_checked(src, w, h, options);
+            (v, None, finite)
+        }
     };
     Ok((
         Texture::from_f32(w, h, working_format(src.format()), v)?,
+        coded,
         finite,
     ))
 }

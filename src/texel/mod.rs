@@ -353,6 +353,17 @@ impl Texels {
         }
     }
 
+    /// The values in runs of `n` (the last may be shorter), for writers
+    /// that fill disjoint parts in parallel.
+    pub fn chunks_mut(&mut self, n: usize) -> Vec<TexelsMut<'_>> {
+        match self {
+            Texels::U8(v) => v.chunks_mut(n).map(TexelsMut::U8).collect(),
+            Texels::U16(v) => v.chunks_mut(n).map(TexelsMut::U16).collect(),
+            Texels::F16(v) => v.chunks_mut(n).map(TexelsMut::F16).collect(),
+            Texels::F32(v) => v.chunks_mut(n).map(TexelsMut::F32).collect(),
+        }
+    }
+
     /// The values as bytes in the host's byte order (little-endian on
     /// every platform parvo's writers run on).
     pub fn bytes_mut(&mut self) -> &mut [u8] {
@@ -363,6 +374,19 @@ impl Texels {
             Texels::F32(v) => bytemuck::cast_slice_mut(v),
         }
     }
+}
+
+/// A run of values of one storage type to fill ([`Texels::chunks_mut`]).
+#[derive(Debug)]
+pub enum TexelsMut<'a> {
+    /// 8-bit normalised values.
+    U8(&'a mut [u8]),
+    /// 16-bit normalised values.
+    U16(&'a mut [u16]),
+    /// Half floats.
+    F16(&'a mut [f16]),
+    /// Single floats.
+    F32(&'a mut [f32]),
 }
 
 /// Decode stored values to linear-light f32 (`channels` values per texel).
@@ -409,12 +433,29 @@ fn decode_f32(format: &Format, i: &[f32], o: &mut [f32]) {
 /// ±65504 rather than becoming infinite (filter overshoot near the top of
 /// the range must not create infinities). Runs in parallel on large inputs.
 pub fn encode_from_linear(format: &Format, linear: &[f32], out: &mut Texels) {
+    use rayon::prelude::*;
+    assert_eq!(linear.len(), out.len(), "decode/encode length mismatch");
     let chunk = format.channels as usize * 16384;
+    if linear.len() <= chunk {
+        if let Some(o) = out.chunks_mut(chunk.max(1)).pop() {
+            encode_into(format, linear, o);
+        }
+        return;
+    }
+    out.chunks_mut(chunk)
+        .into_par_iter()
+        .zip(linear.par_chunks(chunk))
+        .for_each(|(o, i)| encode_into(format, i, o));
+}
+
+/// [`encode_from_linear`] of whole texels into a run of values, on the
+/// calling thread.
+pub fn encode_into(format: &Format, linear: &[f32], out: TexelsMut<'_>) {
     match out {
-        Texels::U8(o) => par_zip(linear, o, chunk, |i, o| encode_u8(format, i, o)),
-        Texels::U16(o) => par_zip(linear, o, chunk, |i, o| encode_u16(format, i, o)),
-        Texels::F16(o) => par_zip(linear, o, chunk, |i, o| {
-            let mut tmp = i.to_vec();
+        TexelsMut::U8(o) => encode_u8(format, linear, o),
+        TexelsMut::U16(o) => encode_u16(format, linear, o),
+        TexelsMut::F16(o) => {
+            let mut tmp = linear.to_vec();
             encode_float_srgb(format, &mut tmp);
             for v in &mut tmp {
                 if v.is_finite() {
@@ -422,11 +463,11 @@ pub fn encode_from_linear(format: &Format, linear: &[f32], out: &mut Texels) {
                 }
             }
             o.convert_from_f32_slice(&tmp);
-        }),
-        Texels::F32(o) => par_zip(linear, o, chunk, |i, o| {
-            o.copy_from_slice(i);
+        }
+        TexelsMut::F32(o) => {
+            o.copy_from_slice(linear);
             encode_float_srgb(format, o);
-        }),
+        }
     }
 }
 
@@ -447,17 +488,38 @@ fn par_zip<A: Sync, B: Send>(
     }
 }
 
-/// Decode 8-bit values (whole texels) to linear f32.
+/// Decode 8-bit values (whole texels) to linear f32: one table look-up
+/// per value, the table (sRGB or `c / 255`) chosen per channel once, not
+/// per value.
 pub fn decode_u8(format: &Format, i: &[u8], o: &mut [f32]) {
-    let ch = format.channels as usize;
-    let t = srgb::tables();
-    for (o, i) in o.chunks_exact_mut(ch).zip(i.chunks_exact(ch)) {
-        for c in 0..ch {
-            o[c] = if format.is_srgb_channel(c) {
-                t.decode8[i[c] as usize]
-            } else {
-                i[c] as f32 * (1.0 / 255.0)
-            };
+    let t = decode8_tables(format);
+    match format.channels {
+        1 => decode_u8_n::<1>(&t, i, o),
+        2 => decode_u8_n::<2>(&t, i, o),
+        3 => decode_u8_n::<3>(&t, i, o),
+        _ => decode_u8_n::<4>(&t, i, o),
+    }
+}
+
+/// The decode table of each channel of an 8-bit `format`.
+fn decode8_tables(format: &Format) -> [&'static [f32; 256]; 4] {
+    static LINEAR: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    let linear = LINEAR.get_or_init(|| std::array::from_fn(|k| k as f32 * (1.0 / 255.0)));
+    let srgb = &srgb::tables().decode8;
+    std::array::from_fn(|c| {
+        if format.is_srgb_channel(c) {
+            srgb
+        } else {
+            linear
+        }
+    })
+}
+
+#[inline]
+fn decode_u8_n<const CH: usize>(t: &[&[f32; 256]; 4], i: &[u8], o: &mut [f32]) {
+    for (o, i) in o.chunks_exact_mut(CH).zip(i.chunks_exact(CH)) {
+        for c in 0..CH {
+            o[c] = t[c][i[c] as usize];
         }
     }
 }
@@ -476,17 +538,34 @@ pub fn decode_u16(format: &Format, i: &[u16], o: &mut [f32]) {
     }
 }
 
-/// Encode linear f32 (whole texels) to 8-bit values.
+/// Encode linear f32 (whole texels) to 8-bit values, rounding to nearest
+/// (sRGB channels by the exact curve's decision thresholds).
 pub fn encode_u8(format: &Format, i: &[f32], o: &mut [u8]) {
-    let ch = format.channels as usize;
+    match (format.channels, format.color_space, format.has_alpha()) {
+        (1, ColorSpace::Srgb, _) => encode_u8_n::<1, 1>(i, o),
+        (2, ColorSpace::Srgb, true) => encode_u8_n::<2, 1>(i, o),
+        (2, ColorSpace::Srgb, false) => encode_u8_n::<2, 2>(i, o),
+        (3, ColorSpace::Srgb, _) => encode_u8_n::<3, 3>(i, o),
+        (4, ColorSpace::Srgb, true) => encode_u8_n::<4, 3>(i, o),
+        (4, ColorSpace::Srgb, false) => encode_u8_n::<4, 4>(i, o),
+        (1, _, _) => encode_u8_n::<1, 0>(i, o),
+        (2, _, _) => encode_u8_n::<2, 0>(i, o),
+        (3, _, _) => encode_u8_n::<3, 0>(i, o),
+        _ => encode_u8_n::<4, 0>(i, o),
+    }
+}
+
+/// `CH` channels of which the first `CC` are sRGB-encoded, the rest
+/// linear.
+#[inline]
+fn encode_u8_n<const CH: usize, const CC: usize>(i: &[f32], o: &mut [u8]) {
     let t = srgb::tables();
-    for (o, i) in o.chunks_exact_mut(ch).zip(i.chunks_exact(ch)) {
-        for c in 0..ch {
-            o[c] = if format.is_srgb_channel(c) {
-                srgb::encode_u8_with(t, i[c])
-            } else {
-                unorm8(i[c])
-            };
+    for (o, i) in o.chunks_exact_mut(CH).zip(i.chunks_exact(CH)) {
+        for c in 0..CC {
+            o[c] = srgb::encode_u8_with(t, i[c]);
+        }
+        for c in CC..CH {
+            o[c] = unorm8(i[c]);
         }
     }
 }

@@ -57,7 +57,7 @@ pub(crate) struct Tables {
     /// `thresholds[k]`: smallest linear value that encodes to code k + 1.
     pub thresholds: [f32; 256],
     /// For each bucket of linear [0, 1], the code of its lower edge.
-    pub bucket: Vec<u8>,
+    pub bucket: Box<[u8; BUCKETS + 1]>,
 }
 
 pub(crate) fn tables() -> &'static Tables {
@@ -78,7 +78,7 @@ pub(crate) fn tables() -> &'static Tables {
             }
             *t = f;
         }
-        let mut bucket = vec![0u8; BUCKETS + 1];
+        let mut bucket = Box::new([0u8; BUCKETS + 1]);
         let mut code = 0usize;
         for (b, slot) in bucket.iter_mut().enumerate() {
             let lo = b as f32 / BUCKETS as f32;
@@ -102,19 +102,18 @@ pub fn encode_u8(l: f32) -> u8 {
     encode_u8_with(t, l)
 }
 
+/// [`encode_u8`] with the tables at hand. Branch-free: the clamp maps
+/// NaN and values ≤ 0 to bucket 0 (code 0) and values ≥ 1 to the last
+/// bucket (code 255); the thresholds are at least 0.000303 apart (the
+/// linear toe's step) and the buckets 1/4096 = 0.000244 wide, so a bucket
+/// holds at most one threshold and one comparison settles the code.
 #[inline]
 pub(crate) fn encode_u8_with(t: &Tables, l: f32) -> u8 {
-    if l.is_nan() || l <= 0.0 {
-        return 0;
-    }
-    if l >= 1.0 {
-        return 255;
-    }
-    let mut code = t.bucket[(l * BUCKETS as f32) as usize] as usize;
-    while l >= t.thresholds[code] {
-        code += 1;
-    }
-    code as u8
+    // `max` returns the other operand for NaN (`clamp` would keep it).
+    #[allow(clippy::manual_clamp)]
+    let l = l.max(0.0).min(1.0);
+    let code = t.bucket[((l * BUCKETS as f32) as usize).min(BUCKETS)];
+    code + u8::from(l >= t.thresholds[code as usize])
 }
 
 /// 8-bit sRGB code to linear light.
@@ -142,6 +141,34 @@ mod tests {
         for i in 0..=200_000u32 {
             let l = i as f32 / 200_000.0;
             let want = (encode_f64(l as f64) * 255.0).round() as u8;
+            assert_eq!(encode_u8(l), want, "l = {l}");
+        }
+    }
+
+    #[test]
+    fn encode_u8_is_exact_next_to_every_threshold_and_at_the_extremes() {
+        let t = tables();
+        for k in 0..255usize {
+            let th = t.thresholds[k];
+            let below = f32::from_bits(th.to_bits() - 1);
+            assert_eq!(encode_u8(th), k as u8 + 1, "at threshold {k}");
+            assert_eq!(encode_u8(below), k as u8, "below threshold {k}");
+            // The loop the tables were made with agrees.
+            let mut code = 0usize;
+            while code < 255 && below >= t.thresholds[code] {
+                code += 1;
+            }
+            assert_eq!(code, k);
+        }
+        for (l, want) in [
+            (f32::NAN, 0),
+            (-1.0, 0),
+            (f32::NEG_INFINITY, 0),
+            (0.0, 0),
+            (1.0, 255),
+            (1.5, 255),
+            (f32::INFINITY, 255),
+        ] {
             assert_eq!(encode_u8(l), want, "l = {l}");
         }
     }

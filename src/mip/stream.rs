@@ -1,0 +1,152 @@
+//! Several box levels at once, band by band.
+//!
+//! A chain that rounds once keeps every level unrounded (linear f32) until
+//! it is stored. Doing that level by level means writing level 1 in f32 —
+//! four times the bytes of an RGBA8 level 0 — and reading it back for
+//! level 2: on a 4096² RGBA8 image 64 MiB of fresh pages, whose first
+//! touch alone costs more than the whole chain's arithmetic. Here level 0
+//! is cut into bands of 2^m rows; each band is decoded to linear f32 in a
+//! per-thread scratch buffer, reduced through levels 1..=m with the 2×2
+//! row kernel ([`super::fast::box_row_f32`]), and each level's new rows
+//! are encoded to the stored type while they are in cache. Only level m
+//! is kept in f32 (1/4^m of level 0), to build the rest of the chain from.
+//! Decoding, the row kernel and encoding are row-local, so the levels are
+//! the ones the whole-level path makes, bit for bit.
+
+use rayon::prelude::*;
+
+use super::fast::box_row_f32;
+use super::{MipFilter, MipOptions};
+use crate::texel::{AlphaMode, Format, Texels};
+use crate::texture::Texture;
+
+/// Most levels made per band (bands of up to 2^4 = 16 level-0 rows: a
+/// band of a 16384-wide RGBA level 0 is 4 MiB of f32).
+pub const MAX_LEVELS: u32 = 4;
+
+/// How many levels after level 0 a band-by-band box build makes for a
+/// chain of `sizes` (level 0 first) under `options`: 0 when it does not
+/// apply (another filter, the fast paths off, alpha coverage, a first
+/// reduction that does not halve both sides).
+pub fn levels(sizes: &[(u32, u32)], options: &MipOptions) -> usize {
+    let Some(&(w, h)) = sizes.first() else {
+        return 0;
+    };
+    if options.filter != MipFilter::Box || !options.fast_paths || options.alpha_coverage.is_some() {
+        return 0;
+    }
+    let m = w
+        .trailing_zeros()
+        .min(h.trailing_zeros())
+        .min(MAX_LEVELS)
+        .min(sizes.len().saturating_sub(1) as u32) as usize;
+    // Every level up to m halves exactly (true for even sides; checked
+    // against the chain's own sizes all the same).
+    (0..=m)
+        .take_while(|&k| sizes[k] == (w >> k, h >> k))
+        .last()
+        .unwrap_or(0)
+}
+
+thread_local! {
+    /// A band of one level and of the next, in linear f32.
+    static SCRATCH: std::cell::RefCell<(Vec<f32>, Vec<f32>)> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+}
+
+/// What [`box_levels`] made.
+pub struct Levels {
+    /// Levels 1..=m in the stored format.
+    pub stored: Vec<Texels>,
+    /// Level m in linear f32, unrounded.
+    pub last: Vec<f32>,
+    /// Every value of level 1 came out finite (tracked by the RGBA kernel
+    /// only; `false` means "not known").
+    pub finite: bool,
+}
+
+/// Levels 1..=`m` of `base` (box filter; both sides divisible by 2^m,
+/// m ≥ 1) encoded to `stored` (the channels of `base`), and level m in
+/// linear f32 (see the module docs).
+pub fn box_levels(base: &Texture, m: usize, stored: Format) -> Levels {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let fmt = base.format();
+    let ch = fmt.channels as usize;
+    let (w, h) = (base.width() as usize, base.height() as usize);
+    let rows = 1usize << m;
+    let bands = h / rows;
+    let straight = fmt
+        .alpha_channel()
+        .filter(|_| fmt.alpha == AlphaMode::Straight);
+    let mut outs: Vec<Texels> = (1..=m)
+        .map(|k| Texels::zeroed(stored.channel_type, (w >> k) * (h >> k) * ch))
+        .collect();
+    let per_last = (w >> m) * ch;
+    let mut last: Vec<f32> = crate::mem::zeroed(per_last * bands);
+    // Per band: level k's rows in each output, then level m's f32 row.
+    let mut per_band: Vec<Vec<crate::texel::TexelsMut<'_>>> =
+        (0..bands).map(|_| Vec::new()).collect();
+    for (k, o) in outs.iter_mut().enumerate() {
+        let n = (w >> (k + 1)) * (rows >> (k + 1)) * ch;
+        for (b, c) in o.chunks_mut(n).into_iter().enumerate() {
+            per_band[b].push(c);
+        }
+    }
+    let finite = AtomicBool::new(ch == 4);
+    let texels = base.texels();
+    let in_place = match (texels, fmt.color_space, fmt.channel_type) {
+        (Texels::F32(v), crate::texel::ColorSpace::Linear, _) => Some(v.as_slice()),
+        _ => None,
+    };
+    let band_len = rows * w * ch;
+    per_band
+        .into_par_iter()
+        .zip(last.par_chunks_mut(per_last))
+        .enumerate()
+        .for_each(|(b, (outs, kept))| {
+            // Per-thread scratch that outlives the call: fresh buffers per
+            // rayon job would fault in a megabyte of new pages each time.
+            SCRATCH.with_borrow_mut(|(cur, next)| {
+                // One level's rows from the previous level's (`lw` wide,
+                // `lr` rows) into `next`.
+                let reduce = |prev: &[f32], lw: usize, lr: usize, next: &mut Vec<f32>| {
+                    let nw = lw / 2;
+                    next.resize(nw * (lr / 2) * ch, 0.0);
+                    let mut all_finite = true;
+                    for (r, o) in next.chunks_exact_mut(nw * ch).enumerate() {
+                        let r0 = &prev[2 * r * lw * ch..(2 * r + 1) * lw * ch];
+                        let r1 = &prev[(2 * r + 1) * lw * ch..(2 * r + 2) * lw * ch];
+                        all_finite &= box_row_f32(r0, r1, o, ch, straight);
+                    }
+                    all_finite
+                };
+                // Level 1 from level 0's band, decoded (or read in place).
+                let level1_finite = match in_place {
+                    Some(v) => reduce(&v[b * band_len..][..band_len], w, rows, next),
+                    None => {
+                        cur.resize(band_len, 0.0);
+                        crate::texel::decode_range_to_linear(&fmt, texels, b * band_len, cur);
+                        reduce(cur, w, rows, next)
+                    }
+                };
+                if !level1_finite {
+                    finite.store(false, Ordering::Relaxed);
+                }
+                let (mut lw, mut lr) = (w / 2, rows / 2);
+                for (k, out) in outs.into_iter().enumerate() {
+                    if k > 0 {
+                        reduce(cur, lw, lr, next);
+                        (lw, lr) = (lw / 2, lr / 2);
+                    }
+                    crate::texel::encode_into(&stored, next, out);
+                    std::mem::swap(cur, next);
+                }
+                kept.copy_from_slice(&cur[..per_last]);
+            })
+        });
+    Levels {
+        stored: outs,
+        last,
+        finite: finite.into_inner(),
+    }
+}
