@@ -22,6 +22,7 @@ mod level_template_ignores_extension;
 mod maketx_tx_read_as_one_level;
 mod multipart_and_multipage_silently_first;
 mod normal_maps_filtered_as_encoded_codes;
+mod pillow_bc1_dds_refused;
 mod png_colour_chunks_ignored;
 mod premultiplied_exr_written_premultiplied_to_png;
 mod roughness_map_ringing_went_below_zero;
