@@ -281,7 +281,7 @@ fn what_parvo_cannot_read_is_named() {
                 vec![0; 64],
             ]
             .concat(),
-            "DXGI format 24",
+            "DXGI format R10G10B10A2_UNORM (24)",
         ),
         (
             [

@@ -9,9 +9,11 @@ read are listed as `skip` with its error; a reader failing on a format it
 is listed as reading is a failure (the table is the README's "which reader
 reads what"). Then the other direction: DDS files Pillow writes (L, LA,
 RGB, RGBA, DXT1, DXT3, DXT5, BC5) are read by `parvo info` and decoded by
-`parvo mip` to the texels Pillow itself decodes.
+`parvo mip` to the texels Pillow itself decodes, and so is Pillow's own
+test file `bc1.dds` (DX10 resource dimension 0), also as BC1_TYPELESS.
 """
 import json
+import os
 
 import numpy as np
 from PIL import Image
@@ -241,5 +243,27 @@ for mode, pixel_format in PILLOW:
     # (bcdec and Pillow): one code is allowed there, none elsewhere.
     tol = 1 if pixel_format else 0
     check(d <= tol, f"parvo decodes {label} to the texels Pillow decodes", f"max |diff| {d} codes, allowed {tol}")
+
+# Pillow's own test file `bc1.dds` (tests/data/peer/pillow_bc1.dds): a DX10
+# header whose resource dimension and array size are 0, and the same file
+# with DXGI format 70 (BC1_TYPELESS), as Pillow's `bc1_typeless.dds` is.
+# Pillow reads both; parvo must read both to Pillow's texels (BC1 rounding:
+# one code).
+root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+with open(os.path.join(root, "tests", "data", "peer", "pillow_bc1.dds"), "rb") as f:
+    bc1 = f.read()
+for name, data in (("bc1", bc1), ("bc1_typeless", bc1[:128] + (70).to_bytes(4, "little") + bc1[132:])):
+    path = f"{work}/peer_{name}.dds"
+    with open(path, "wb") as f:
+        f.write(data)
+    with Image.open(path) as im:
+        theirs = np.asarray(im.convert("RGBA"))
+    dump = f"{work}/peer_{name}_{{level}}.png"
+    if not check(run(parvo, "mip", path, "-o", dump, "--levels", "1").returncode == 0,
+                 f"parvo reads Pillow's {name}.dds (resource dimension 0)"):
+        continue
+    ours = with_channels(oiio_levels(dump.replace("{level}", "0"), fmt="", unassociated=True)[0][0])
+    d = int(np.max(np.abs(ours.astype(np.int32) - theirs.astype(np.int32))))
+    check(d <= 1, f"parvo decodes Pillow's {name}.dds to the texels Pillow decodes", f"max |diff| {d} codes")
 
 finish()

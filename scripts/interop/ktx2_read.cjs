@@ -10,5 +10,8 @@ console.log(JSON.stringify({
   levels: c.levels.length, scheme: c.supercompressionScheme, model: d.colorModel,
   transfer: d.transferFunction, block: d.texelBlockDimension, bytesPlane0: d.bytesPlane[0],
   uncompressed: c.levels.map(l => l.uncompressedByteLength),
+  // Each sample: bit offset, bit length - 1, channel id with qualifiers.
+  samples: d.samples.map(s => [s.bitOffset, s.bitLength, s.channelType]),
+  flags: d.flags,
   stored: c.levels.map(l => l.levelData.length),
 }));

@@ -57,9 +57,12 @@
 //! `ATI1`/`BC4U`/`BC4S`, `ATI2`/`BC5U`/`BC5S`, and BC1–BC7 in DX10 files,
 //! decoded with [`crate::compress`]; `DXT2`/`DXT4` are premultiplied), and
 //! the uncompressed DXGI formats above plus `B8G8R8A8`/`B8G8R8X8` (UNORM
-//! and sRGB) and the `TYPELESS` variants of those with a UNORM meaning.
-//! Cube maps, volumes and texture arrays are refused by name, as is every
-//! other format.
+//! and sRGB) and the `TYPELESS` variants of those with a UNORM meaning
+//! (read as UNORM, as Pillow reads them, with a note). A DX10 resource
+//! dimension of 0 (unknown, as in Pillow's `bc1.dds`) is read as a 2-D
+//! texture from the header's width and height, as Pillow and OpenImageIO
+//! do. Cube maps, volumes, texture arrays and palettised files are refused
+//! by name, as is every other format (DXGI formats by their names).
 
 use std::io::Write;
 use std::path::Path;
@@ -623,7 +626,8 @@ struct Masked {
 
 /// The DXGI formats parvo reads (uncompressed): format number, channels,
 /// type, sRGB, R/B swapped (BGRA), 4th channel padding (BGRX), name.
-const DXGI_PLAIN: [(u32, u8, ChannelType, bool, bool, bool, &str); 25] = {
+/// `TYPELESS` formats are read as UNORM.
+const DXGI_PLAIN: [(u32, u8, ChannelType, bool, bool, bool, &str); 27] = {
     use ChannelType::*;
     [
         (2, 4, F32, false, false, false, "R32G32B32A32_FLOAT"),
@@ -649,6 +653,8 @@ const DXGI_PLAIN: [(u32, u8, ChannelType, bool, bool, bool, &str); 25] = {
         (65, 1, U8, false, false, false, "A8_UNORM"),
         (87, 4, U8, false, true, false, "B8G8R8A8_UNORM"),
         (88, 4, U8, false, true, true, "B8G8R8X8_UNORM"),
+        (90, 4, U8, false, true, false, "B8G8R8A8_TYPELESS"),
+        (92, 4, U8, false, true, true, "B8G8R8X8_TYPELESS"),
         (91, 4, U8, true, true, false, "B8G8R8A8_UNORM_SRGB"),
         (93, 4, U8, true, true, true, "B8G8R8X8_UNORM_SRGB"),
     ]
@@ -681,6 +687,155 @@ const DXGI_BLOCKS: [(u32, BlockFormat, bool); 21] = {
         (99, Bc7, true),
     ]
 };
+
+/// The name of a `DXGI_FORMAT` value (Microsoft's `DXGI_FORMAT_*`
+/// enumerants without the prefix), `None` for values it does not define.
+pub fn dxgi_name(v: u32) -> Option<&'static str> {
+    Some(match v {
+        0 => "UNKNOWN",
+        1 => "R32G32B32A32_TYPELESS",
+        2 => "R32G32B32A32_FLOAT",
+        3 => "R32G32B32A32_UINT",
+        4 => "R32G32B32A32_SINT",
+        5 => "R32G32B32_TYPELESS",
+        6 => "R32G32B32_FLOAT",
+        7 => "R32G32B32_UINT",
+        8 => "R32G32B32_SINT",
+        9 => "R16G16B16A16_TYPELESS",
+        10 => "R16G16B16A16_FLOAT",
+        11 => "R16G16B16A16_UNORM",
+        12 => "R16G16B16A16_UINT",
+        13 => "R16G16B16A16_SNORM",
+        14 => "R16G16B16A16_SINT",
+        15 => "R32G32_TYPELESS",
+        16 => "R32G32_FLOAT",
+        17 => "R32G32_UINT",
+        18 => "R32G32_SINT",
+        19 => "R32G8X24_TYPELESS",
+        20 => "D32_FLOAT_S8X24_UINT",
+        21 => "R32_FLOAT_X8X24_TYPELESS",
+        22 => "X32_TYPELESS_G8X24_UINT",
+        23 => "R10G10B10A2_TYPELESS",
+        24 => "R10G10B10A2_UNORM",
+        25 => "R10G10B10A2_UINT",
+        26 => "R11G11B10_FLOAT",
+        27 => "R8G8B8A8_TYPELESS",
+        28 => "R8G8B8A8_UNORM",
+        29 => "R8G8B8A8_UNORM_SRGB",
+        30 => "R8G8B8A8_UINT",
+        31 => "R8G8B8A8_SNORM",
+        32 => "R8G8B8A8_SINT",
+        33 => "R16G16_TYPELESS",
+        34 => "R16G16_FLOAT",
+        35 => "R16G16_UNORM",
+        36 => "R16G16_UINT",
+        37 => "R16G16_SNORM",
+        38 => "R16G16_SINT",
+        39 => "R32_TYPELESS",
+        40 => "D32_FLOAT",
+        41 => "R32_FLOAT",
+        42 => "R32_UINT",
+        43 => "R32_SINT",
+        44 => "R24G8_TYPELESS",
+        45 => "D24_UNORM_S8_UINT",
+        46 => "R24_UNORM_X8_TYPELESS",
+        47 => "X24_TYPELESS_G8_UINT",
+        48 => "R8G8_TYPELESS",
+        49 => "R8G8_UNORM",
+        50 => "R8G8_UINT",
+        51 => "R8G8_SNORM",
+        52 => "R8G8_SINT",
+        53 => "R16_TYPELESS",
+        54 => "R16_FLOAT",
+        55 => "D16_UNORM",
+        56 => "R16_UNORM",
+        57 => "R16_UINT",
+        58 => "R16_SNORM",
+        59 => "R16_SINT",
+        60 => "R8_TYPELESS",
+        61 => "R8_UNORM",
+        62 => "R8_UINT",
+        63 => "R8_SNORM",
+        64 => "R8_SINT",
+        65 => "A8_UNORM",
+        66 => "R1_UNORM",
+        67 => "R9G9B9E5_SHAREDEXP",
+        68 => "R8G8_B8G8_UNORM",
+        69 => "G8R8_G8B8_UNORM",
+        70 => "BC1_TYPELESS",
+        71 => "BC1_UNORM",
+        72 => "BC1_UNORM_SRGB",
+        73 => "BC2_TYPELESS",
+        74 => "BC2_UNORM",
+        75 => "BC2_UNORM_SRGB",
+        76 => "BC3_TYPELESS",
+        77 => "BC3_UNORM",
+        78 => "BC3_UNORM_SRGB",
+        79 => "BC4_TYPELESS",
+        80 => "BC4_UNORM",
+        81 => "BC4_SNORM",
+        82 => "BC5_TYPELESS",
+        83 => "BC5_UNORM",
+        84 => "BC5_SNORM",
+        85 => "B5G6R5_UNORM",
+        86 => "B5G5R5A1_UNORM",
+        87 => "B8G8R8A8_UNORM",
+        88 => "B8G8R8X8_UNORM",
+        89 => "R10G10B10_XR_BIAS_A2_UNORM",
+        90 => "B8G8R8A8_TYPELESS",
+        91 => "B8G8R8A8_UNORM_SRGB",
+        92 => "B8G8R8X8_TYPELESS",
+        93 => "B8G8R8X8_UNORM_SRGB",
+        94 => "BC6H_TYPELESS",
+        95 => "BC6H_UF16",
+        96 => "BC6H_SF16",
+        97 => "BC7_TYPELESS",
+        98 => "BC7_UNORM",
+        99 => "BC7_UNORM_SRGB",
+        100 => "AYUV",
+        101 => "Y410",
+        102 => "Y416",
+        103 => "NV12",
+        104 => "P010",
+        105 => "P016",
+        106 => "OPAQUE_420",
+        107 => "YUY2",
+        108 => "Y210",
+        109 => "Y216",
+        110 => "NV11",
+        111 => "AI44",
+        112 => "IA44",
+        113 => "P8",
+        114 => "A8P8",
+        115 => "B4G4R4A4_UNORM",
+        130 => "P208",
+        131 => "V208",
+        132 => "V408",
+        189 => "SAMPLER_FEEDBACK_MIN_MIP_OPAQUE",
+        190 => "SAMPLER_FEEDBACK_MIP_REGION_USED_OPAQUE",
+        _ => return None,
+    })
+}
+
+/// `NAME (n)`, or the number alone when DXGI defines no such format.
+fn dxgi_describe(v: u32) -> String {
+    match dxgi_name(v) {
+        Some(n) => format!("{n} ({v})"),
+        None => format!("{v} (not a DXGI format)"),
+    }
+}
+
+/// The meaning a `_TYPELESS` DXGI format is read with, as Pillow reads
+/// them (OpenImageIO 3.2 refuses them): UNORM (`UF16` for BC6H), or `None`
+/// when `v` is not typeless.
+fn typeless_reading(v: u32) -> Option<String> {
+    let name = dxgi_name(v)?.strip_suffix("_TYPELESS")?;
+    Some(if name == "BC6H" {
+        "BC6H_UF16".to_string()
+    } else {
+        format!("{name}_UNORM")
+    })
+}
 
 fn fourcc_text(v: u32) -> String {
     let d3d = match v {
@@ -739,7 +894,10 @@ fn stored_of(h: &Header) -> Result<(Stored, String)> {
                     srgb,
                     alpha,
                 },
-                format!("DX10 {}{}", bf, if srgb { "_UNORM_SRGB" } else { "" }),
+                format!(
+                    "DX10 {}",
+                    dxgi_name(d.dxgi_format).unwrap_or(if srgb { "sRGB" } else { "" })
+                ),
             ));
         }
         let &(_, ch, ty, srgb, swap, padded, name) = DXGI_PLAIN
@@ -747,9 +905,9 @@ fn stored_of(h: &Header) -> Result<(Stored, String)> {
             .find(|e| e.0 == d.dxgi_format)
             .ok_or_else(|| {
                 decode_err(format!(
-                    "DXGI format {} is not one parvo reads (it reads the uncompressed 8-bit, 16-bit, \
-                     half and float R/RG/RGB/RGBA/BGRA formats and BC1-BC7)",
-                    d.dxgi_format
+                    "DXGI format {} is not one parvo reads (it reads the uncompressed UNORM 8-bit \
+                     and 16-bit, half and float R/RG/RGB/RGBA/BGRA formats and BC1-BC7)",
+                    dxgi_describe(d.dxgi_format)
                 ))
             })?;
         let cs = if srgb { ColorSpace::Srgb } else { lin };
@@ -780,8 +938,36 @@ fn stored_of(h: &Header) -> Result<(Stored, String)> {
             format!("DX10 {name}"),
         ));
     }
+    // DirectDraw's palette flags (ddraw.h `DDPF_PALETTEINDEXED*`): texels
+    // are indices into a palette stored after the header.
+    let palette = [
+        (0x800, "1-bit"),
+        (0x1000, "2-bit"),
+        (0x8, "4-bit"),
+        (0x20, "8-bit"),
+        (0x10, ""),
+    ]
+    .iter()
+    .find(|(flag, _)| pf.flags & flag != 0);
+    if let Some((_, bits)) = palette {
+        return Err(decode_err(format!(
+            "this is a palettised DDS ({}palette indices, pixel format flags {:#x}), which parvo \
+             does not read",
+            if bits.is_empty() {
+                String::new()
+            } else {
+                format!("{bits} ")
+            },
+            pf.flags
+        )));
+    }
     if pf.flags & ddpf::FOURCC != 0 {
         let code = pf.fourcc;
+        if code == 0 {
+            return Err(decode_err(
+                "the pixel format says a fourCC names the format, but the fourCC is empty (0)",
+            ));
+        }
         let st = match &code.to_le_bytes() {
             b"DXT1" => blocks(BlockFormat::Bc1, AlphaMode::Straight),
             b"DXT2" => blocks(BlockFormat::Bc2, AlphaMode::Premultiplied),
@@ -859,7 +1045,8 @@ fn stored_of(h: &Header) -> Result<(Stored, String)> {
         (1, [a, 0, 0, 0])
     } else {
         return Err(decode_err(format!(
-            "pixel format flags {:#x} name no known layout",
+            "the pixel format flags ({:#x}) set none of RGB, LUMINANCE, ALPHA or FOURCC, so they \
+             name no texel layout",
             pf.flags
         )));
     };
@@ -1053,11 +1240,34 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
                 d.array_size
             )));
         }
-        if d.resource_dimension != D3D10_RESOURCE_DIMENSION_TEXTURE2D {
-            return Err(decode_err(format!(
-                "resource dimension {} is not a 2-D texture",
-                d.resource_dimension
-            )));
+        match d.resource_dimension {
+            D3D10_RESOURCE_DIMENSION_TEXTURE2D => {}
+            // Unknown: Pillow and OpenImageIO do not read the field and take
+            // the header's width and height (Pillow's own `bc1.dds` has 0).
+            0 => {}
+            // A 1-D texture is a row of texels.
+            2 if h == 1 => {}
+            2 => {
+                return Err(decode_err(format!(
+                    "the DX10 header says a 1-D texture, but the height is {h}"
+                )));
+            }
+            4 => {
+                return Err(decode_err(
+                    "volume textures are not supported (parvo reads 2-D textures)",
+                ));
+            }
+            1 => {
+                return Err(decode_err(
+                    "the DX10 header describes a buffer, not a texture",
+                ));
+            }
+            n => {
+                return Err(decode_err(format!(
+                    "the DX10 header's resource dimension is {n}; it defines 2 (1-D), 3 (2-D) \
+                     and 4 (3-D texture)"
+                )));
+            }
         }
     }
     let (stored, desc) = stored_of(&header)?;
@@ -1118,6 +1328,14 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         _ => vec!["R".into(), "G".into(), "B".into(), "A".into()],
     };
     info.attributes = vec![("dds:format".into(), desc)];
+    if let Some(d) = &header.dx10
+        && let Some(meaning) = typeless_reading(d.dxgi_format)
+    {
+        info.notes.push(format!(
+            "DXGI format {} says no type; read as {meaning}, as Pillow reads it",
+            dxgi_name(d.dxgi_format).unwrap_or_default()
+        ));
+    }
     if let Stored::Blocks { format: bf, .. } = stored {
         info.attributes
             .push(("dds:compression".into(), bf.name().to_string()));

@@ -1,4 +1,4 @@
-//! KTX 2.0: uncompressed textures with the full mip chain.
+//! KTX 2.0: uncompressed and BC1–BC7 textures with the full mip chain.
 //!
 //! The writer is written by hand from the KTX 2.0 specification (Khronos,
 //! "KTX File Format Specification", version 2.0): the `ktx2` crate only
@@ -21,11 +21,23 @@
 //!    lcm(texel size, 4) bytes.
 //!
 //! Formats: `R8`, `R8G8`, `R8G8B8`, `R8G8B8A8` (UNORM and SRGB), the
-//! `R16…_UNORM`, `R16…_SFLOAT` and `R32…_SFLOAT` families. Vulkan has no
-//! sRGB 16-bit or float formats, and its `R8G8_SRGB` would sRGB-decode the
-//! alpha of grey + alpha, so callers convert such data first
-//! ([`storable`]). Reading uses the `ktx2` crate, which validates the
-//! structure.
+//! `R16…_UNORM`, `R16…_SFLOAT` and `R32…_SFLOAT` families, and BC1–BC7.
+//! Vulkan has no sRGB 16-bit or float formats and no grey + alpha format
+//! (its two-channel formats are R, G data), so callers convert such data
+//! first ([`storable`]: linear values, grey + alpha widened to RGBA).
+//! Every DFD follows the KTX 2.0 restrictions on top of the Khronos Data
+//! Format Specification's description of the format: under the sRGB
+//! transfer the alpha sample (channel 15) carries
+//! `KHR_DF_SAMPLE_DATATYPE_LINEAR` and no other sample does; the
+//! premultiplied flag is set only where there is an alpha channel
+//! (`tests/regression/ktx2_bc3_srgb_dfd_fails_ktx_validate.rs` checks every
+//! format against an independent reading of both).
+//!
+//! Reading uses the `ktx2` crate, which validates the structure. Two
+//! channels are R, G data unless the `KTXswizzle` key is `rrrg` (the
+//! specification's luminance + alpha); other swizzles are reported, not
+//! applied. Formats parvo does not read are named by their Vulkan names,
+//! and Basis Universal files (BasisLZ/ETC1S, UASTC) as such.
 
 use std::path::Path;
 
@@ -55,8 +67,12 @@ fn decode_err(reason: impl std::fmt::Display) -> Error {
     }
 }
 
-/// The `VkFormat` for a texel format, if Vulkan has one.
+/// The `VkFormat` for a texel format, if Vulkan has one (grey + alpha has
+/// none: see [`storable`]).
 pub fn vk_format(f: &Format) -> Option<u32> {
+    if f.channels == 2 && f.has_alpha() {
+        return None;
+    }
     let i = (f.channels as usize).checked_sub(1).filter(|&i| i < 4)?;
     let srgb = f.color_space == ColorSpace::Srgb;
     let table: [u32; 4] = match (f.channel_type, srgb) {
@@ -70,7 +86,10 @@ pub fn vk_format(f: &Format) -> Option<u32> {
     Some(table[i])
 }
 
-/// The texel format of a `VkFormat` parvo reads (inverse of [`vk_format`]).
+/// The texel format of a `VkFormat` parvo reads (inverse of [`vk_format`]):
+/// two channels are R, G data ([`AlphaMode::None`]), four are RGBA with
+/// straight alpha (the DFD's premultiplied flag and a `KTXswizzle` of
+/// `rrrg` are applied by [`load`]).
 pub fn format_of_vk(vk: u32) -> Option<Format> {
     use ChannelType::*;
     use ColorSpace::*;
@@ -86,18 +105,115 @@ pub fn format_of_vk(vk: u32) -> Option<Format> {
         ),
         _ => return None,
     };
-    Some(Format::new(ch as u8 + 1, ty, cs))
+    let f = Format::new(ch as u8 + 1, ty, cs);
+    Some(if f.channels == 2 {
+        f.with_alpha(AlphaMode::None)
+    } else {
+        f
+    })
+}
+
+/// The Vulkan name of a `VkFormat` value (`VK_FORMAT_R8G8_UNORM`), for
+/// every format the KTX 2.0 specification allows (the `ktx2` crate's
+/// table); `None` for values it does not list.
+pub fn vk_format_name(vk: u32) -> Option<String> {
+    if vk == 0 {
+        return Some("VK_FORMAT_UNDEFINED".into());
+    }
+    let f = ::ktx2::Format::new(vk)?;
+    // The crate's `Debug` prints the enumerant's name, or `Format(n)` for
+    // a value it does not list: only listed values are named.
+    ::ktx2::Format::ALL
+        .contains(&f)
+        .then(|| format!("VK_FORMAT_{f:?}"))
+}
+
+/// `VK_FORMAT_… (n)`, or `vkFormat n` when the value has no name.
+fn vk_describe(vk: u32) -> String {
+    match vk_format_name(vk) {
+        Some(name) => format!("{name} ({vk})"),
+        None => format!("vkFormat {vk}"),
+    }
+}
+
+/// The Khronos Data Format colour models (`KHR_DF_MODEL_*`) a KTX2 file
+/// can name, for messages.
+fn model_name(model: u32) -> Option<&'static str> {
+    Some(match model {
+        0 => "UNSPECIFIED",
+        1 => "RGBSDA",
+        2 => "YUVSDA",
+        128 => "BC1A",
+        129 => "BC2",
+        130 => "BC3",
+        131 => "BC4",
+        132 => "BC5",
+        133 => "BC6H",
+        134 => "BC7",
+        160 => "ETC1",
+        161 => "ETC2",
+        162 => "ASTC",
+        163 => "ETC1S",
+        164 => "PVRTC",
+        165 => "PVRTC2",
+        166 => "UASTC",
+        167 => "UASTC_HDR_4x4",
+        168 => "UASTC_HDR_6x6",
+        _ => return None,
+    })
+}
+
+/// Why a file's texel format is not read, in words: Basis Universal
+/// (vkFormat 0 with BasisLZ supercompression or a UASTC/ETC1S colour
+/// model) is named as such, other formats by their Vulkan names.
+fn unsupported_format(vk: u32, scheme: u32, model: Option<u32>) -> Error {
+    const TRANSCODE: &str = "transcode it to a BC or uncompressed format first \
+                             (for example with KTX-Software's `ktx transcode`)";
+    let reason = match (vk, scheme, model) {
+        (0, 1, _) | (0, _, Some(163)) => format!(
+            "this is a Basis Universal texture (ETC1S, BasisLZ supercompression), which parvo \
+             does not read; {TRANSCODE}"
+        ),
+        (0, _, Some(166..=168)) => format!(
+            "this is a Basis Universal texture ({}), which parvo does not read; {TRANSCODE}",
+            model
+                .and_then(model_name)
+                .unwrap_or("UASTC")
+                .replace('_', " ")
+        ),
+        (0, _, m) => format!(
+            "the vkFormat is VK_FORMAT_UNDEFINED (0): the texels are described only by the data \
+             format descriptor{}, which parvo does not read",
+            m.map_or(String::new(), |m| match model_name(m) {
+                Some(n) => format!(" (colour model {n})"),
+                None => format!(" (colour model {m})"),
+            })
+        ),
+        _ => format!(
+            "{} is not a format parvo reads (it reads the uncompressed R, RG, RGB and RGBA \
+             UNORM/SRGB 8-bit, UNORM 16-bit and SFLOAT 16/32-bit formats, and BC1-BC7)",
+            vk_describe(vk)
+        ),
+    };
+    decode_err(reason)
 }
 
 /// The closest format KTX2 can store `f` in: same values where Vulkan has
-/// the format; sRGB u16 and float become linear; sRGB grey + alpha (u8)
-/// becomes RGBA so the alpha is not sRGB-decoded.
+/// the format; sRGB u16 and float become linear; grey + alpha becomes RGBA
+/// (grey in R, G and B).
+///
+/// Vulkan has no grey + alpha format: its two-channel formats are R, G
+/// data, and that is how every reader takes them (`R8G8_SRGB` would even
+/// sRGB-decode the alpha). The KTX 2.0 specification's other way, `R8G8`
+/// with the `KTXswizzle` key `rrrg`, is read (see [`load`]) but not
+/// written, since readers that ignore the key would show red and green.
+/// Two channels without alpha stay two channels (`R8G8`, `R16G16`, ...).
 pub fn storable(f: Format) -> Format {
     let mut out = f;
     if f.color_space == ColorSpace::Srgb && f.channel_type != ChannelType::U8 {
         out.color_space = ColorSpace::Linear;
     }
-    if f.color_space == ColorSpace::Srgb && f.channel_type == ChannelType::U8 && f.channels == 2 {
+    if f.channels == 2 && f.has_alpha() {
         out.channels = 4;
     }
     out
@@ -202,9 +318,11 @@ impl Supercompression {
                     .map_err(|_| encode_err(format!("zlib level {level}: use 1 to 12")))?;
                 let mut c = libdeflater::Compressor::new(lvl);
                 let mut out = vec![0u8; c.zlib_compress_bound(data.len())];
-                let n = c
-                    .zlib_compress(data, &mut out)
-                    .map_err(|e| encode_err(format!("zlib: {e:?}")))?;
+                // The output is sized by the compressor's own bound, so
+                // running out of room is a fault of the bound, not of data.
+                let n = c.zlib_compress(data, &mut out).map_err(|_| {
+                    encode_err("zlib compression needed more room than its bound promised")
+                })?;
                 out.truncate(n);
                 Ok(out)
             }
@@ -224,17 +342,34 @@ fn decompress(scheme: u32, data: &[u8], len: u64, limits: &Limits) -> Result<Vec
     }
     let len = len as usize;
     let out = match scheme {
-        2 => zstd::bulk::decompress(data, len).map_err(|e| decode_err(format!("zstd: {e}")))?,
+        2 => zstd::bulk::decompress(data, len)
+            .map_err(|e| decode_err(format!("a zstd level does not decompress: {e}")))?,
         3 => {
             let mut out = vec![0u8; len];
             let n = libdeflater::Decompressor::new()
                 .zlib_decompress(data, &mut out)
-                .map_err(|e| decode_err(format!("zlib: {e:?}")))?;
+                .map_err(|e| {
+                    decode_err(match e {
+                        libdeflater::DecompressionError::InsufficientSpace => {
+                            format!("a zlib level inflates to more than the {len} bytes its index declares")
+                        }
+                        _ => "a zlib level is corrupt (bad data or checksum)".to_string(),
+                    })
+                })?;
             out.truncate(n);
             out
         }
-        1 => return Err(decode_err("BasisLZ supercompression is not supported")),
-        s => return Err(decode_err(format!("unknown supercompression scheme {s}"))),
+        1 => {
+            return Err(decode_err(
+                "BasisLZ supercompression (Basis Universal ETC1S) is not one parvo reads",
+            ));
+        }
+        s => {
+            return Err(decode_err(format!(
+                "supercompression scheme {s} is not one the KTX 2.0 specification defines \
+                 (0 none, 1 BasisLZ, 2 Zstandard, 3 zlib)"
+            )));
+        }
     };
     if out.len() != len {
         return Err(decode_err(format!(
@@ -294,7 +429,18 @@ pub fn block_format_of_vk(vk: u32) -> Option<(BlockFormat, bool, bool)> {
 /// colour, or `ALPHAPRESENT` with alpha; BC2/BC3 alpha at bit 0 and colour
 /// at bit 64; BC5 red and green), sample ranges 0..`u32::MAX` (the values
 /// `libktx` writes), FLOAT (and SIGNED) for BC6H.
+///
+/// The KTX 2.0 rules on top of the format's own description (section
+/// "Data Format Descriptor", Restrictions): with the sRGB transfer the
+/// alpha sample (channel 15: BC2's and BC3's alpha block) carries
+/// `KHR_DF_SAMPLE_DATATYPE_LINEAR`, and no other sample does; the transfer
+/// is sRGB only for the formats that have an `_SRGB` variant (BC1, BC2,
+/// BC3, BC7), and the premultiplied flag is set only for formats with an
+/// alpha channel (the Data Format Specification asks irrelevant fields to
+/// be zero).
 pub fn dfd_block(f: BlockFormat, srgb: bool, premultiplied: bool, alpha: bool) -> Vec<u8> {
+    let srgb = srgb && block_has_srgb(f);
+    let premultiplied = premultiplied && block_has_alpha(f, alpha);
     let (model, samples): (u32, Vec<(u32, u32, u32)>) = match f {
         // (bit offset, bit length − 1, channel id | qualifiers)
         BlockFormat::Bc1 => (128, vec![(0, 63, u32::from(alpha))]),
@@ -318,7 +464,10 @@ pub fn dfd_block(f: BlockFormat, srgb: bool, premultiplied: bool, alpha: bool) -
         f.block_bytes() as u32,
         0,
     ];
-    for (offset, len1, id) in samples {
+    for (offset, len1, mut id) in samples {
+        if srgb && id == 15 {
+            id |= 0x10; // KHR_DF_SAMPLE_DATATYPE_LINEAR: alpha is not sRGB-encoded
+        }
         w.push(offset | (len1 << 16) | (id << 24));
         w.push(0);
         let (lower, upper) = match f {
@@ -335,6 +484,23 @@ pub fn dfd_block(f: BlockFormat, srgb: bool, premultiplied: bool, alpha: bool) -
     w.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 
+/// True for the block formats with an `_SRGB` variant.
+fn block_has_srgb(f: BlockFormat) -> bool {
+    matches!(
+        f,
+        BlockFormat::Bc1 | BlockFormat::Bc2 | BlockFormat::Bc3 | BlockFormat::Bc7
+    )
+}
+
+/// True when a block format stores alpha (BC1 only in its `RGBA` form).
+fn block_has_alpha(f: BlockFormat, bc1_alpha: bool) -> bool {
+    match f {
+        BlockFormat::Bc1 => bc1_alpha,
+        BlockFormat::Bc2 | BlockFormat::Bc3 | BlockFormat::Bc7 => true,
+        _ => false,
+    }
+}
+
 /// Serialise `levels` (level 0 first, sizes rounding down) as KTX2 bytes
 /// written to `out`.
 pub fn write_to(levels: &[Texture], opts: &SaveOptions, out: &mut impl Write) -> Result<()> {
@@ -344,7 +510,7 @@ pub fn write_to(levels: &[Texture], opts: &SaveOptions, out: &mut impl Write) ->
     let f = first.format();
     let vk = vk_format(&f).ok_or_else(|| {
         encode_err(format!(
-            "no Vulkan format for {f} (convert it with ktx2::storable)"
+            "Vulkan has no format for {f} (convert the levels to ktx2::storable's format first)"
         ))
     })?;
     let desc = Desc {
@@ -534,22 +700,27 @@ pub fn stored_fingerprint(path: &Path) -> Option<String> {
         })
 }
 
-/// The premultiplied-alpha flag of the first basic DFD block, read from
-/// the bytes (not through the `ktx2` crate's DFD parser: see [`reader`]).
-fn dfd_premultiplied(bytes: &[u8]) -> bool {
+/// The colour model / primaries / transfer / flags word of the first DFD
+/// block, read from the bytes (not through the `ktx2` crate's DFD parser:
+/// see [`reader`]), when it is a Khronos basic block.
+fn dfd_model_word(bytes: &[u8]) -> Option<u32> {
     let word = |at: usize| {
         bytes
-            .get(at..at + 4)
+            .get(at..at.checked_add(4)?)
             .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     };
     // dfdByteOffset; then the total size word, the vendor/type word, the
     // version/size word, and the model/primaries/transfer/flags word.
-    let Some(at) = word(48).map(|a| a as usize) else {
-        return false;
-    };
-    at.checked_add(12)
-        .and_then(word)
-        .is_some_and(|w| (w >> 24) & 1 == 1)
+    let at = word(48)? as usize;
+    if word(52)? < 16 || word(at.checked_add(4)?)? != 0 {
+        return None;
+    }
+    word(at.checked_add(12)?)
+}
+
+/// The premultiplied-alpha flag of the basic DFD block.
+fn dfd_premultiplied(bytes: &[u8]) -> bool {
+    dfd_model_word(bytes).is_some_and(|w| (w >> 24) & 1 == 1)
 }
 
 /// The `ktx2` crate's reader of `bytes`, after the checks it lacks: its
@@ -585,7 +756,25 @@ fn reader(bytes: &[u8]) -> Result<::ktx2::Reader<&[u8]>> {
     }
     std::panic::catch_unwind(|| ::ktx2::Reader::new(bytes))
         .map_err(|_| decode_err("malformed file (the KTX2 parser failed)"))?
-        .map_err(decode_err)
+        .map_err(parse_error)
+}
+
+/// The `ktx2` crate's parse errors in a user's words.
+fn parse_error(e: ::ktx2::ParseError) -> Error {
+    use ::ktx2::ParseError::*;
+    decode_err(match e {
+        BadMagic => "not a KTX 2.0 file (its 12-byte identifier is missing)".to_string(),
+        ZeroWidth => "the header gives a width of 0".to_string(),
+        ZeroFaceCount => "the header gives a face count of 0".to_string(),
+        InvalidSampleBitLength => {
+            "the data format descriptor has a sample with an invalid bit length".to_string()
+        }
+        UnexpectedEnd => {
+            "the file is truncated: its header, an index or a level ends past the end of the file"
+                .to_string()
+        }
+        other => format!("malformed file ({other})"),
+    })
 }
 
 /// Load a KTX2 file: every mip level of a 2-D texture (uncompressed, or
@@ -598,10 +787,29 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
 fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
     let r = reader(bytes)?;
     let h = r.header();
-    if h.pixel_depth > 1 || h.layer_count > 1 || h.face_count != 1 {
+    if h.face_count == 6 {
         return Err(decode_err(
-            "only 2-D textures are supported (no arrays, cube maps or volumes)",
+            "cube maps are not supported (parvo reads 2-D textures)",
         ));
+    }
+    if h.face_count != 1 {
+        return Err(decode_err(format!(
+            "the header gives {} faces (1, or 6 for a cube map)",
+            h.face_count
+        )));
+    }
+    if h.pixel_depth > 1 {
+        return Err(decode_err(format!(
+            "volume textures are not supported (this one is {} texels deep; parvo reads 2-D \
+             textures)",
+            h.pixel_depth
+        )));
+    }
+    if h.layer_count > 1 {
+        return Err(decode_err(format!(
+            "texture arrays are not supported (this one has {} layers)",
+            h.layer_count
+        )));
     }
     let scheme = u32::from_le_bytes(bytes[44..48].try_into().map_err(decode_err)?);
     let vk = h.format.map(|f| f.value()).unwrap_or(0);
@@ -609,13 +817,33 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
     let mut format = match block {
         Some((bf, srgb, _)) => bf.decoded_format(srgb),
         None => format_of_vk(vk).ok_or_else(|| {
-            decode_err(format!(
-                "vkFormat {vk} is not a format parvo reads (uncompressed R/RG/RGB/RGBA 8/16-bit and \
-                 float, BC1-BC7)"
-            ))
+            unsupported_format(vk, scheme, dfd_model_word(bytes).map(|w| w & 0xff))
         })?,
     };
     let premultiplied = dfd_premultiplied(bytes);
+    // `KTXswizzle` (KTX 2.0 section "KTXswizzle"): `rrrg` on a two-channel
+    // format is the specification's luminance + alpha; the other mappings
+    // that keep the stored channels' meaning need nothing, and any other
+    // is reported, not applied.
+    let swizzle = r
+        .key_value_data()
+        .find(|(k, _)| *k == "KTXswizzle")
+        .map(|(_, v)| {
+            String::from_utf8_lossy(v)
+                .trim_end_matches('\0')
+                .to_string()
+        });
+    let mut notes = Vec::new();
+    if let Some(sw) = &swizzle {
+        let identity = ["r001", "rg01", "rgb1", "rgba"][(format.channels as usize).clamp(1, 4) - 1];
+        if format.channels == 2 && sw == "rrrg" && block.is_none() {
+            format = format.with_alpha(AlphaMode::Straight);
+        } else if sw != identity && sw != "rgba" && !(format.channels == 1 && sw == "rrr1") {
+            notes.push(format!(
+                "KTXswizzle `{sw}` is not applied: the channels are read as stored"
+            ));
+        }
+    }
     if premultiplied && format.has_alpha() {
         format = format.with_alpha(AlphaMode::Premultiplied);
     }
@@ -710,7 +938,7 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
             (k.to_string(), text)
         })
         .collect();
-    attributes.push(("vkFormat".into(), format!("{:?}", h.format)));
+    attributes.push(("vkFormat".into(), vk_describe(vk)));
     if let Some((bf, srgb, _)) = block {
         attributes.push((
             "stored".into(),
@@ -723,12 +951,11 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
             match scheme {
                 2 => "zstd".into(),
                 3 => "zlib".into(),
-                s => s.to_string(),
+                s => format!("scheme {s}"),
             },
         ));
     }
     attributes.sort();
-    let mut notes = Vec::new();
     let wrap = super::recorded_wrap(
         attributes
             .iter()
@@ -739,9 +966,9 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
     let format = levels.first().map_or(format, |l| l.format());
     let mut info = SourceInfo::new(FileFormat::Ktx2, &format);
     info.notes = notes;
-    info.channel_names = match format.channels {
-        1 => vec!["R".into()],
-        2 => vec!["R".into(), "G".into()],
+    info.channel_names = match (format.channels, format.has_alpha()) {
+        (1, _) => vec!["R".into()],
+        (2, false) => vec!["R".into(), "G".into()],
         _ => super::layout_names(&format),
     };
     info.own_mips = levels.len() > 1;
