@@ -5,6 +5,8 @@
 mod util;
 
 mod alpha_coverage_bound_broken_by_8bit_rounding;
+#[cfg(feature = "encode")]
+mod bc_quality_steps_identical;
 mod dds_headers_pillow_read_as_black;
 mod exif_orientation_ignored;
 mod exr_bytes_differ_between_runs;
