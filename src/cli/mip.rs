@@ -338,9 +338,10 @@ pub struct MipArgs {
         value_name = "Q",
         requires = "compress",
         long_help = "Encoder effort for --compress. bc7 and bc6h: Intel ISPC's very-fast, basic or \
-        slow profile; bc1 and bc3: ISPC at fast and normal, libsquish's iterative cluster fit at slow \
-        (bc1 with alpha always uses libsquish: range fit, cluster fit, iterative cluster fit); bc4 and \
-        bc5 have one encoder."
+        slow profile; bc1 and bc3: ISPC's kernel at fast, refitted by least squares at normal (about \
+        nvcompress -fast's time), searched from every start including libsquish's iterative cluster \
+        fit at slow, each step at least as good as the one before (bc1 with alpha uses libsquish: \
+        range fit, cluster fit, iterative cluster fit); bc4 and bc5 have one encoder."
     )]
     quality: QualityArg,
 

@@ -1,32 +1,51 @@
-//! Block encoders (feature `encode`), from two crates:
+//! Block encoders (feature `encode`): two crates and one fit of our own.
 //! - `intel_tex_2` (Intel's ISPC texture compressor: SIMD kernels, with
-//!   quality profiles for BC7 and BC6H) for BC4, BC5, BC6H and BC7, and for
-//!   BC1 and BC3 at `fast` and `normal`;
+//!   quality profiles for BC7 and BC6H) for BC4, BC5, BC6H and BC7, and
+//!   for BC1 and BC3 as they are at `fast` and as the first guess at
+//!   `normal` and `slow`;
+//! - a BC1 colour-block fit of our own (the private `colour` module: the
+//!   refinement of nvtt and libsquish, least squares on the chosen
+//!   indices, the best 5:6:5 rounding, a ±1 search), which refits ISPC's
+//!   BC1 blocks and BC3 colour halves at `normal` and `slow` (ISPC's
+//!   kernel has no settings, so `fast` and `normal` were once the same
+//!   bytes);
 //! - `texpresso` (a port of libsquish) for BC1 with alpha (its one-bit
 //!   punch-through mode: texels with alpha below 128 become transparent,
-//!   which ISPC's BC1 does not encode) and for BC1/BC3 at `slow` (iterative
-//!   cluster fit).
+//!   which ISPC's BC1 does not encode; range fit, cluster fit and
+//!   iterative cluster fit per step), and at `slow` one more start for the
+//!   fit (its iterative cluster fit).
 //!
-//! Measured on the 1024² `builtin:photo` (2-core Zen 4 VM): ISPC's BC1
-//! gives 38.74 dB in 3 ms on one thread, texpresso's cluster fit 38.92 dB
-//! in 1.2 s on two: 400× the time for 0.2 dB, so ISPC is the default.
+//! Each step of opaque BC1 and of BC3 keeps, per block, the best of what
+//! the step before it found and its own search (measured by the error the
+//! fit minimises), so more effort never gives a worse block. `benches/bc_peers.sh` measures
+//! the steps beside nvcompress, quicktex and etcpak (the README's table):
+//! `normal` is above `nvcompress -fast` on every photo there at about its
+//! time on one thread; `slow` costs what libsquish's iterative cluster fit
+//! costs.
+//!
+//! The colour error is the squared difference of the stored codes, each
+//! channel weighted alike (what `psnr` and `--stats` report; for sRGB data
+//! the codes are already perceptually spaced); straight-alpha BC3 weighs
+//! each texel's colour by its alpha.
 //!
 //! Every encoder reads the level in [`input_format`]: the texels are
 //! already filtered and quantised, so the encoder's job is only the block
 //! fit. Levels whose sides are not multiples of 4 are stored in whole
-//! blocks: texpresso masks the texels outside the level out of the fit;
-//! for the ISPC kernels (which read whole blocks) the level is padded by
-//! repeating its last column and row, so the outside texels pull the
-//! endpoints towards colours the block already has. Large levels are cut
-//! into bands of block rows encoded on all threads; the bytes do not
-//! depend on the number of threads.
+//! blocks: texpresso and the colour fit leave the texels outside the level
+//! out of the fit; for the ISPC kernels (which read whole blocks) the level
+//! is padded by repeating its last column and row, so the outside texels
+//! pull the endpoints towards colours the block already has. Large levels
+//! are cut into bands of block rows encoded on all threads; the bytes do
+//! not depend on the number of threads.
 
 use rayon::prelude::*;
 
 use super::{BlockFormat, Quality, can_encode, input_format};
 use crate::error::{Error, Result};
-use crate::texel::{AlphaMode, ColorSpace, Texels};
+use crate::texel::{AlphaMode, Texels};
 use crate::texture::Texture;
+
+mod colour;
 
 fn encode_err(reason: impl Into<String>) -> Error {
     Error::Encode {
@@ -56,25 +75,15 @@ pub fn encode(format: BlockFormat, quality: Quality, level: &Texture) -> Result<
     let out_len = format.level_bytes(level.width(), level.height()) as usize;
     let mut out = vec![0u8; out_len];
     match (format, level.texels()) {
-        (BlockFormat::Bc1 | BlockFormat::Bc3, Texels::U8(v))
-            if quality == Quality::Slow || (format == BlockFormat::Bc1 && f.has_alpha()) =>
-        {
-            let fmt = if format == BlockFormat::Bc1 {
-                texpresso::Format::Bc1
-            } else {
-                texpresso::Format::Bc3
-            };
+        (BlockFormat::Bc1, Texels::U8(v)) if f.has_alpha() => {
+            let fmt = texpresso::Format::Bc1;
             let params = texpresso::Params {
                 algorithm: match quality {
                     Quality::Fast => texpresso::Algorithm::RangeFit,
                     Quality::Normal => texpresso::Algorithm::ClusterFit,
                     Quality::Slow => texpresso::Algorithm::IterativeClusterFit,
                 },
-                weights: if f.color_space == ColorSpace::Srgb {
-                    texpresso::COLOUR_WEIGHTS_PERCEPTUAL
-                } else {
-                    texpresso::COLOUR_WEIGHTS_UNIFORM
-                },
+                weights: texpresso::COLOUR_WEIGHTS_UNIFORM,
                 weigh_colour_by_alpha: f.alpha == AlphaMode::Straight,
             };
             if fmt.compressed_size(w, h) != out_len {
@@ -127,6 +136,17 @@ pub fn encode(format: BlockFormat, quality: Quality, level: &Texture) -> Result<
                     }
                 }
             });
+            if matches!(format, BlockFormat::Bc1 | BlockFormat::Bc3) && quality != Quality::Fast {
+                refine_colour(
+                    v,
+                    w,
+                    h,
+                    format,
+                    quality,
+                    f.alpha == AlphaMode::Straight,
+                    &mut out,
+                );
+            }
         }
         (BlockFormat::Bc6h { .. }, Texels::F16(v)) => {
             // ISPC reads RGBA halves; unsigned half has no negatives, and
@@ -201,5 +221,103 @@ fn ispc_bands(
                 }
             }
             kernel(&buf, pw, rows, dst);
+        });
+}
+
+/// The effort of the colour fit per quality step (see [`colour`]).
+/// `normal`: least squares from the best start until the error stops
+/// falling (at most 4 rounds), about nvcompress -fast's time; `slow`:
+/// every start refined in both BC1 modes, with the ±1 endpoint search.
+fn colour_effort(quality: Quality) -> colour::Effort {
+    match quality {
+        Quality::Fast | Quality::Normal => colour::Effort {
+            least_squares: 4,
+            neighbour_passes: 0,
+            refine_all_starts: false,
+            three_colour: false,
+        },
+        Quality::Slow => colour::Effort {
+            least_squares: 8,
+            neighbour_passes: 32,
+            refine_all_starts: true,
+            three_colour: true,
+        },
+    }
+}
+
+/// Refit the colour blocks ISPC wrote into `out` (BC1, or BC3's colour
+/// halves) with [`colour::fit`], ISPC's endpoints among the starts, and at
+/// `slow` libsquish's iterative cluster fit (texpresso) too. `v` is the
+/// level's RGBA texels; `by_alpha` weighs each texel's colour error by its
+/// straight alpha (BC3).
+fn refine_colour(
+    v: &[u8],
+    w: usize,
+    h: usize,
+    format: BlockFormat,
+    quality: Quality,
+    by_alpha: bool,
+    out: &mut [u8],
+) {
+    let effort = colour_effort(quality);
+    let bb = format.block_bytes();
+    let off = if format == BlockFormat::Bc3 { 8 } else { 0 };
+    let bw = w.div_ceil(4);
+    let squish = quality == Quality::Slow;
+    let squish_params = texpresso::Params {
+        algorithm: texpresso::Algorithm::IterativeClusterFit,
+        weights: texpresso::COLOUR_WEIGHTS_UNIFORM,
+        weigh_colour_by_alpha: by_alpha,
+    };
+    let three = format == BlockFormat::Bc1;
+    out.par_chunks_mut(bw * bb)
+        .enumerate()
+        .for_each(|(by, row)| {
+            for (bx, blk) in row.chunks_exact_mut(bb).enumerate() {
+                let mut px = colour::BlockTexels::default();
+                let mut rgba = [[0u8; 4]; 16];
+                let mut mask = 0u32;
+                for (i, texel) in rgba.iter_mut().enumerate() {
+                    let (x, y) = (bx * 4 + i % 4, by * 4 + i / 4);
+                    let inside = x < w && y < h;
+                    let (x, y) = (x.min(w - 1), y.min(h - 1));
+                    let t = &v[(y * w + x) * 4..(y * w + x) * 4 + 4];
+                    texel.copy_from_slice(t);
+                    px.r[i] = t[0] as f32;
+                    px.g[i] = t[1] as f32;
+                    px.b[i] = t[2] as f32;
+                    px.w[i] = match (inside, by_alpha) {
+                        (false, _) => 0.0,
+                        (true, false) => 1.0,
+                        (true, true) => (t[3] as f32 + 1.0) / 256.0,
+                    };
+                    if inside {
+                        mask |= 1 << i;
+                    }
+                }
+                let endpoints = |b: &[u8]| {
+                    (
+                        u16::from_le_bytes([b[0], b[1]]),
+                        u16::from_le_bytes([b[2], b[3]]),
+                    )
+                };
+                let mut starts = [(0u16, 0u16); 2];
+                starts[0] = endpoints(&blk[off..off + 4]);
+                let n = if squish {
+                    let mut sq = [0u8; 16];
+                    let fmt = if three {
+                        texpresso::Format::Bc1
+                    } else {
+                        texpresso::Format::Bc3
+                    };
+                    fmt.compress_block_masked(rgba, mask, squish_params, &mut sq);
+                    starts[1] = endpoints(&sq[off..off + 4]);
+                    2
+                } else {
+                    1
+                };
+                let c = colour::fit(&px, &starts[..n], &effort, three);
+                blk[off..off + 8].copy_from_slice(&c);
+            }
         });
 }

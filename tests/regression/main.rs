@@ -6,6 +6,7 @@ mod util;
 
 mod alpha_coverage_bound_broken_by_8bit_rounding;
 mod batch_ergonomics;
+mod bc_quality_steps_identical;
 mod colour_assumption_silent_and_no_color_for_sampling;
 mod compress_batch_hangs;
 mod dds_headers_pillow_read_as_black;
