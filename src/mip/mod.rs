@@ -1,25 +1,34 @@
 //! Mip pyramids: level sizes, downsampling filters, and the chain builder.
 //!
-//! [`build`] turns a level-0 [`Texture`] into a [`MipChain`]. Each level is
-//! computed from the previous one as stored (as GPU drivers and maketx do),
-//! in linear light, then encoded to the source's format:
+//! [`build`] turns a level-0 [`Texture`] into a [`MipChain`]. Every level
+//! is reduced in linear light from the *unrounded* level before it and
+//! rounded to the source's format once, as it is stored: a chain that
+//! reduced each level from the previous level's 8-bit codes (as some
+//! drivers and tools do) drifts by a code or more within a few levels
+//! (`tests/regression/eight_bit_chains_drift.rs`, `scripts/drift-table.py`).
 //!
 //! 1. Level 0 is checked for NaN/Inf under [`NanPolicy`] (float types).
 //! 2. For each next level, [`level_size`] gives the size; the reduction runs
-//!    on rayon over destination rows. Two tiers:
-//!    - fast paths ([`fast`]) for the 2×2 box of even-sized levels: integer
-//!      arithmetic for u8 (linear and table-driven sRGB), a fused kernel for
-//!      linear f32;
+//!    on rayon. Tiers:
+//!    - the 2×2 box of levels that halve exactly: levels 1..=m are made
+//!      band by band ([`stream`]): bands of level 0 decoded to f32, reduced
+//!      through m levels in per-thread scratch, each level's rows encoded
+//!      while in cache; only level m is kept in f32;
 //!    - the general separable path ([`separable`]) for every filter, type,
-//!      size and wrap mode. It is the reference the fast paths are tested
-//!      against (`tests/mip_fast_paths_match_plain.rs`).
+//!      size and wrap mode, from linear f32 working levels. It is the
+//!      reference the fast paths are tested against
+//!      (`tests/mip_fast_paths_match_plain.rs`).
+//!    - [`reduce`] (one level, stored type in and out) keeps the integer
+//!      fast paths ([`fast`]): exact for a single reduction.
 //! 3. Optional per-level post-processing: alpha-test coverage preservation
-//!    ([`alpha`]). Normal maps take their own path ([`normal`]): decoded to
-//!    unit vectors, averaged in f32, renormalised and encoded once per level.
+//!    ([`alpha`]) on the working level, measured after the stored type's
+//!    rounding. Normal maps take their own path ([`normal`]): decoded to
+//!    unit vectors, averaged in f32, renormalised and encoded once per
+//!    level.
 //!
-//! Memory: the general path decodes the source level to f32 once
-//! (4 bytes × channels × texels) unless it is already linear f32; the fast
-//! paths use only a row of scratch per thread.
+//! Memory: the source, the stored chain, and the working level in f32
+//! (level m of the band build, 1/4^m of level 0; level 1, a quarter of
+//! level 0 in f32, on the separable path).
 
 pub mod alpha;
 pub mod fast;
