@@ -501,6 +501,7 @@ fn settings(args: &MipArgs) -> Settings {
             channels: args.channels.clone(),
             subimage: args.subimage,
             auto_orient: !args.no_auto_orient,
+            ..Default::default()
         },
         limits: Limits {
             max_width: args.max_width,

@@ -107,6 +107,10 @@ pub struct SourceInfo {
     /// The block format the file stores its levels in (decoded on load),
     /// if it is block-compressed.
     pub blocks: Option<crate::compress::BlockFormat>,
+    /// The kind of environment map the file declares (only ever set when
+    /// [`LoadOptions::environment`] asks to describe them; see
+    /// [`EnvironmentMaps`]).
+    pub environment: Option<Environment>,
 }
 
 impl SourceInfo {
@@ -121,6 +125,7 @@ impl SourceInfo {
             attributes: Vec::new(),
             notes: Vec::new(),
             blocks: None,
+            environment: None,
         }
     }
 
@@ -186,6 +191,80 @@ pub(crate) fn recorded_wrap(text: Option<&str>, notes: &mut Vec<String>) -> Opti
     }
 }
 
+/// An environment map's projection, as OpenEXR's `envmap` attribute and
+/// the `textureformat` maketx writes name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Environment {
+    /// Latitude-longitude (equirectangular): `LatLong Environment`,
+    /// `envmap` 0.
+    LatLong,
+    /// Six cube faces in one image: `CubeFace Environment`, `envmap` 1
+    /// (OpenEXR stacks the faces top to bottom).
+    Cube,
+}
+
+impl Environment {
+    /// The kind in words ("lat-long", "cube-face").
+    pub fn name(self) -> &'static str {
+        match self {
+            Environment::LatLong => "lat-long",
+            Environment::Cube => "cube-face",
+        }
+    }
+}
+
+impl fmt::Display for Environment {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What a loader does with an environment map (a cube-face or lat-long
+/// OpenEXR or TIFF): nothing in parvo filters or samples one as what it
+/// is yet, and taking it for a plain texture filters a cube's faces
+/// into each other and wraps a lat-long map's poles, so the default
+/// refuses it. Describing it (what `parvo info` does) loads its texels
+/// as stored with [`SourceInfo::environment`] set and a note.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum EnvironmentMaps {
+    /// Refuse the file with an error naming the kind (the default).
+    #[default]
+    Refuse,
+    /// Load it as stored, marked as an environment map.
+    Describe,
+}
+
+/// Refuse an environment map of `kind` or note it, as `options` say;
+/// `detail` describes what the file holds.
+pub(crate) fn environment_map(
+    format: &'static str,
+    kind: Environment,
+    detail: &str,
+    options: &LoadOptions,
+    notes: &mut Vec<String>,
+) -> Result<()> {
+    match options.environment {
+        EnvironmentMaps::Refuse => Err(Error::Decode {
+            format,
+            reason: format!(
+                "a {kind} environment map ({detail}), which parvo cannot filter or sample yet: \
+                 filtering it as a flat image would blend {}",
+                match kind {
+                    Environment::Cube => "its six faces into each other across their edges",
+                    Environment::LatLong => "across its poles as if the image repeated vertically",
+                }
+            ),
+        }),
+        EnvironmentMaps::Describe => {
+            notes.push(format!(
+                "{kind} environment map ({detail}): described only; parvo cannot filter or \
+                 sample environment maps yet"
+            ));
+            Ok(())
+        }
+    }
+}
+
 /// Choices a loader cannot make from the file alone.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LoadOptions {
@@ -198,6 +277,9 @@ pub struct LoadOptions {
     /// Rotate JPEG and TIFF images by their EXIF orientation, as image
     /// viewers and `oiiotool --autoorient` do. Default: true.
     pub auto_orient: bool,
+    /// Refuse environment maps (the default) or describe them (see
+    /// [`EnvironmentMaps`]).
+    pub environment: EnvironmentMaps,
 }
 
 impl Default for LoadOptions {
@@ -206,6 +288,7 @@ impl Default for LoadOptions {
             channels: None,
             subimage: 0,
             auto_orient: true,
+            environment: EnvironmentMaps::Refuse,
         }
     }
 }
