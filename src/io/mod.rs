@@ -19,6 +19,7 @@
 pub mod atomic;
 pub mod dds;
 pub mod exr;
+mod image_errors;
 pub mod ktx2;
 pub mod limits;
 pub mod png_levels;
@@ -433,18 +434,20 @@ pub fn load_chain_stored(
 /// (1.0 linear, 1/2.2 sRGB, other exponents sRGB with a note); an `iCCP`
 /// profile is not interpreted (sRGB, with a note unless it names sRGB); no
 /// chunk at all means sRGB, at any bit depth.
-fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>)> {
+fn png_transfer(path: &Path, limits: &Limits) -> Result<(ColorSpace, Option<String>)> {
     let file = std::fs::File::open(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         action: "cannot open".into(),
         error: e,
     })?;
-    let reader = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .map_err(|e| Error::Decode {
-            format: "PNG",
-            reason: e.to_string(),
-        })?;
+    let reader = png::Decoder::new_with_limits(
+        std::io::BufReader::new(file),
+        png::Limits {
+            bytes: usize::try_from(limits.max_alloc).unwrap_or(usize::MAX),
+        },
+    )
+    .read_info()
+    .map_err(|e| image_errors::png_error(limits, &e))?;
     let info = reader.info();
     if info.srgb.is_some() {
         return Ok((ColorSpace::Srgb, None));
@@ -491,52 +494,58 @@ fn load_image(
     overlap: Option<Overlap<'_>>,
 ) -> Result<Loaded> {
     use image::{DynamicImage, ImageDecoder, ImageFormat};
-    let decode = |reason: String| Error::Decode {
-        format: "image",
-        reason,
+    let io_err = |action: &str, e| Error::Io {
+        path: path.to_path_buf(),
+        action: action.into(),
+        error: e,
     };
     let mut reader = image::ImageReader::open(path)
-        .map_err(|e| Error::Io {
-            path: path.to_path_buf(),
-            action: "cannot open".into(),
-            error: e,
-        })?
+        .map_err(|e| io_err("cannot open", e))?
         .with_guessed_format()
-        .map_err(|e| decode(e.to_string()))?;
+        .map_err(|e| io_err("cannot read", e))?;
     let file_format = match reader.format() {
         Some(ImageFormat::Png) => FileFormat::Png,
         Some(ImageFormat::Jpeg) => FileFormat::Jpeg,
         Some(ImageFormat::Hdr) => FileFormat::Hdr,
         _ => {
-            return Err(decode(
-                "unrecognised format (parvo reads PNG, JPEG, TIFF, Radiance HDR, OpenEXR, KTX2, DDS)"
+            return Err(Error::Decode {
+                format: "input",
+                reason: "not a file format parvo reads (PNG, JPEG, TIFF, Radiance HDR, OpenEXR, \
+                         KTX2, DDS)"
                     .into(),
-            ));
+            });
         }
     };
     let mut notes = Vec::new();
     let png_cs = if file_format == FileFormat::Png {
-        let (cs, note) = png_transfer(path)?;
+        let (cs, note) = png_transfer(path, limits)?;
         notes.extend(note);
         Some(cs)
     } else {
         None
     };
-    let lim = |e: image::ImageError| match e {
-        image::ImageError::Limits(l) => Error::Limits(format!(
-            "{l} (raise with --max-width/--max-height/--max-alloc)"
-        )),
-        other => Error::Decode {
-            format: file_format.name(),
-            reason: other.to_string(),
-        },
-    };
-    reader.limits(limits.to_image());
+    if file_format == FileFormat::Jpeg {
+        // zune-jpeg decodes a file cut short without a word, as libjpeg
+        // does with a warning (and OpenImageIO without one).
+        if !image_errors::jpeg_has_end_marker(path).map_err(|e| io_err("cannot read", e))? {
+            notes.push(
+                "the JPEG ends without its end-of-image marker: it is probably truncated, and \
+                 what lies past its end is decoded from incomplete data"
+                    .into(),
+            );
+        }
+    }
+    let lim = |e: image::ImageError| image_errors::image_error(file_format, limits, e);
+    // Width and height are checked below against `limits` (whose error
+    // names the limit); the decoders keep the allocation limit.
+    let mut il = limits.to_image();
+    il.max_image_width = None;
+    il.max_image_height = None;
+    reader.limits(il);
     let mut decoder = reader.into_decoder().map_err(lim)?;
     let orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
-    let mut il = limits.to_image();
-    il.reserve(decoder.total_bytes()).map_err(lim)?;
     let (w, h) = decoder.dimensions();
+    limits.check(w as u64, h as u64, decoder.total_bytes())?;
     let ct = decoder.color_type();
     let overlap = overlap.map(|f| {
         let ch = ct.channel_count();
@@ -576,7 +585,10 @@ fn load_image(
                 decoder.read_image(&mut buf)
             })
             .map_err(lim)?;
-            let bad = || decode("decoded buffer does not match its size".into());
+            let bad = || Error::Decode {
+                format: file_format.name(),
+                reason: "the decoded image does not match its declared size".into(),
+            };
             match ct {
                 image::ColorType::L8 => DynamicImage::ImageLuma8(
                     image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
