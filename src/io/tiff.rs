@@ -156,9 +156,20 @@ impl Reader<'_> {
         let colour = match photometric {
             1 | 3 => 1,
             2 => 3,
+            // The crate inverts one WhiteIsZero channel (as libtiff
+            // and OpenImageIO read it: 0 is white).
+            0 if stored_samples == 1 && matches!(bits, 1 | 2 | 4 | 8 | 16 | 32 | 64) => 1,
+            0 if stored_samples == 1 => {
+                return Err(decode_err(format!(
+                    "WhiteIsZero (inverted grey) TIFF of {}-bit samples is not supported (1, 2, \
+                     4, 8 and 16 bits are)",
+                    bits
+                )));
+            }
             0 => {
                 return Err(decode_err(
-                    "WhiteIsZero (inverted grey) TIFF is not supported",
+                    "WhiteIsZero (inverted grey) TIFF with an alpha or extra channel is not \
+                     supported",
                 ));
             }
             4 => return Err(decode_err("transparency-mask TIFF is not supported")),

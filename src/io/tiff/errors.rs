@@ -150,8 +150,8 @@ pub(super) fn words(
             },
             U::UnknownCompressionMethod => "its compression method is unknown".into(),
             U::UnsupportedCompressionMethod(m) => format!(
-                "{} compression is not supported (parvo reads uncompressed, LZW, Deflate/ZIP, \
-                 PackBits, JPEG and CCITT Group 4 TIFF)",
+                "{} is not supported (parvo reads uncompressed, LZW, Deflate/ZIP, PackBits, JPEG \
+                 and CCITT Group 4 TIFF)",
                 compression_name(m.to_u16())
             ),
             U::UnsupportedSampleDepth(b) | U::UnsupportedBitsPerChannel(b) => {
@@ -193,8 +193,9 @@ fn sizes_disagree(r: &chain::Dir, l: &chain::Layout) -> String {
         && b.count != samples
     {
         return format!(
-            "BitsPerSample has {} values for {samples} samples per pixel",
-            b.count
+            "BitsPerSample has {} values for {samples} sample{} per pixel",
+            b.count,
+            if samples == 1 { "" } else { "s" }
         );
     }
     let planes = if r.unsigned(l, tag::PLANAR_CONFIGURATION) == Some(2) {
@@ -228,8 +229,9 @@ fn sizes_disagree(r: &chain::Dir, l: &chain::Layout) -> String {
         if tw > 0 && th > 0 {
             let want = w.div_ceil(tw) * h.div_ceil(th) * planes;
             return format!(
-                "it lists {} tiles, a {w}x{h} image in {tw}x{th} tiles has {}{}",
+                "it lists {} tile{}, a {w}x{h} image in {tw}x{th} tiles has {}{}",
                 o.count,
+                if o.count == 1 { "" } else { "s" },
                 want / planes.max(1),
                 per_plane(want)
             );
@@ -252,8 +254,9 @@ fn sizes_disagree(r: &chain::Dir, l: &chain::Layout) -> String {
         }
         let want = h.div_ceil(rows) * planes;
         return format!(
-            "it lists {} strips, {h} rows in strips of {rows} rows make {}{}",
+            "it lists {} strip{}, {h} rows in strips of {rows} rows make {}{}",
             o.count,
+            if o.count == 1 { "" } else { "s" },
             want / planes.max(1),
             per_plane(want)
         );
@@ -272,7 +275,7 @@ fn compressed_corrupt(raw: Option<&chain::Dir>, l: &chain::Layout, message: &str
              written with the old LZW variant of TIFF 5.0, which parvo does not read"
         ),
         m => format!(
-            "the {}-compressed pixel data is corrupt ({message})",
+            "the pixel data ({}) is corrupt ({message})",
             compression_name(m as u16)
         ),
     })
@@ -283,21 +286,23 @@ fn crate_tag_name(t: Tag) -> String {
 }
 
 pub(super) fn compression_name(c: u16) -> String {
-    match c {
-        1 => "none".into(),
-        2 => "CCITT RLE".into(),
-        3 => "CCITT Group 3".into(),
-        4 => "CCITT Group 4".into(),
-        5 => "LZW".into(),
-        6 => "old-style JPEG".into(),
-        7 => "JPEG".into(),
-        8 | 32946 => "Deflate".into(),
-        32773 => "PackBits".into(),
-        34887 => "LERC".into(),
-        34925 => "LZMA".into(),
-        50000 => "Zstandard".into(),
-        50001 => "WebP".into(),
-        50002 => "JPEG XL".into(),
-        other => format!("compression method {other}"),
-    }
+    let name = match c {
+        1 => return "no compression".into(),
+        2 => "CCITT RLE",
+        3 => "CCITT Group 3",
+        4 => "CCITT Group 4",
+        5 => "LZW",
+        6 => "old-style JPEG",
+        7 => "JPEG",
+        8 | 32946 => "Deflate",
+        32773 => "PackBits",
+        32809 => "ThunderScan",
+        34887 => "LERC",
+        34925 => "LZMA",
+        50000 => "Zstandard",
+        50001 => "WebP",
+        50002 => "JPEG XL",
+        other => return format!("compression method {other}"),
+    };
+    format!("{name} compression")
 }
