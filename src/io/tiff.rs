@@ -10,18 +10,19 @@
 //!   another) and a note says so. A chain of pages that loops back on
 //!   itself is read up to the loop, with a note.
 //! - **Environment maps.** `textureformat` `CubeFace Environment` or
-//!   `LatLong Environment` (maketx `--envcube`, `--envlatl`) marks an
-//!   environment map: it is refused unless the caller asks to describe it
+//!   `LatLong Environment` (maketx `--envlatl`) marks an environment map:
+//!   it is refused unless the caller asks to describe it
 //!   ([`super::EnvironmentMaps`]).
 //! - **Alpha.** `ExtraSamples` (338) says what the channels after the
 //!   colour are: 1 associated alpha (what OpenImageIO and maketx write), 2
 //!   unassociated alpha, 0 not alpha (data). Without the tag, a second or
 //!   fourth channel is taken as associated alpha, OpenImageIO's assumption.
-//! - **Colour.** `PhotometricInterpretation` (262): BlackIsZero grey, RGB,
-//!   or a palette (indexed colour), which is expanded to 8-bit RGB through
-//!   its colour map as OpenImageIO does (entry / 257, rounded down). A
-//!   file without the tag is read as OpenImageIO reads it: grey for one
-//!   channel, two data channels for two, RGB for three or more.
+//! - **Colour.** `PhotometricInterpretation` (262): BlackIsZero grey,
+//!   WhiteIsZero grey (one channel, inverted on load), RGB, or a palette
+//!   (indexed colour), expanded to 8-bit RGB through its colour map as
+//!   OpenImageIO does (entry / 257, rounded down). A file without the tag
+//!   is read as OpenImageIO reads it: grey for one channel, two data
+//!   channels for two, RGB for three or more.
 //! - **Wrap modes and tiling.** Pixar's `wrapmodes` (33303, e.g.
 //!   `black,black`) and the tile size (322, 323).
 //! - **Orientation** (274): applied on load unless turned off (see
@@ -30,11 +31,14 @@
 //! Samples of 8 and 16 bits (unsigned) and 16/32/64-bit floats load as u8,
 //! u16, f16 and f32 (f64 narrowed to f32), with one to four channels,
 //! contiguous or planar (`PlanarConfiguration` 2, every plane read and
-//! interleaved), in strips or tiles. 1-, 2- and 4-bit grey widens to u8
-//! (0 → 0, the largest code → 255). CMYK, YCbCr, Lab, WhiteIsZero, signed
-//! and 32-bit integer samples are refused in plain words. TIFF carries no
-//! transfer function parvo reads, so `--color auto` takes its texels as
-//! linear.
+//! interleaved), in strips or tiles. 1- to 7-bit grey widens to u8 as
+//! OpenImageIO widens it (`v · 255 / (2^bits − 1)` rounded down: 0 → 0,
+//! the largest code → 255). `FillOrder` 2 is read for uncompressed data.
+//! CMYK, YCbCr, Lab, LogLuv, signed, 10-, 12-, 14-, 24- and 32-bit
+//! integer samples, sub-byte colour and compressions the crate lacks
+//! (LZMA, WebP, Zstandard, CCITT Group 3) are refused in plain words.
+//! TIFF carries no transfer function parvo reads, so `--color auto` takes
+//! its texels as linear.
 //!
 //! The `tiff` crate reads the pixels; parvo walks the chain of
 //! directories itself first ([`chain`]), which lets it read files the
@@ -680,7 +684,7 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
             "TIFF",
             kind,
             &format!(
-                "textureformat \"{}\", {}x{} texels per level",
+                "textureformat \"{}\", {}x{}",
                 texture_format.as_deref().unwrap_or(""),
                 dir0.width,
                 dir0.height
