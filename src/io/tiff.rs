@@ -41,7 +41,7 @@
 //! its texels as linear.
 //!
 //! The `tiff` crate reads the pixels; parvo walks the chain of
-//! directories itself first ([`chain`]), which lets it read files the
+//! directories itself first (`tiff/chain.rs`), which lets it read files the
 //! crate alone refuses (no photometric tag, a looping chain, palettes,
 //! tiles stored under the strip tags) and say what is wrong with a broken
 //! file in words rather than the crate's.
