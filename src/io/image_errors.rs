@@ -80,7 +80,10 @@ fn unsupported(format: FileFormat, u: &image::error::UnsupportedError) -> String
                     "its pixels are XYZE (FORMAT=32-bit_rle_xyze), not RGBE; parvo reads RGBE"
                         .into()
                 }
-                _ => strip_debug(&text),
+                (FileFormat::Hdr, false) => "its FORMAT header line names another pixel format \
+                                             than 32-bit_rle_rgbe, the one parvo reads"
+                    .into(),
+                _ => printable(&strip_debug(&text)),
             }
         }
         K::GenericFeature(f) => {
@@ -178,6 +181,31 @@ fn png_format(text: &str) -> String {
     if t.ends_with("must appear at most once") {
         return corrupt(format!("{} appears more than once", chunk(&first)));
     }
+    if t.starts_with("Chunk length wrong") {
+        return corrupt(format!("the length of {} is wrong", chunk(&first)));
+    }
+    if let Some(name) = t.strip_prefix("Unrecognized critical chunk: ") {
+        let name = name.trim_matches('"');
+        return corrupt(
+            if name.len() == 4 && name.chars().all(|c| c.is_ascii_alphabetic()) {
+                format!("it has an unknown critical chunk, {name}, which a reader must not skip")
+            } else {
+                "it has bytes where a chunk should be".into()
+            },
+        );
+    }
+    if t.starts_with("Unexpected restart of") {
+        return corrupt(format!("the run of {first} chunks is interrupted"));
+    }
+    if t.starts_with("Bad gamma value") {
+        return corrupt("its gAMA chunk holds an invalid gamma".into());
+    }
+    if t.contains("fcTL") || t.contains("fdAT") || t.contains("Sequence is not in order") {
+        return corrupt(format!(
+            "its animation chunks are invalid ({})",
+            lower_first(t)
+        ));
+    }
     if t.starts_with("Invalid PNG signature") {
         return "not a PNG file (its 8-byte signature is wrong)".into();
     }
@@ -254,7 +282,7 @@ fn png_format(text: &str) -> String {
     if t.contains("tEXt") || t.contains("iTXt") || t.contains("compressed text") {
         return corrupt(format!("a text chunk is invalid ({})", lower_first(t)));
     }
-    corrupt(lower_first(&strip_debug(t)))
+    corrupt(lower_first(&printable(&strip_debug(t))))
 }
 
 /// The four-letter names in a `png` error's `ChunkType { type: IDAT, … }`
@@ -293,6 +321,27 @@ fn strip_debug(t: &str) -> String {
     }
     out.push_str(rest);
     out.replace('"', "")
+}
+
+/// `t` with control characters and debug escapes of them (`\u{1c}`)
+/// shown as `?`.
+fn printable(t: &str) -> String {
+    let mut out = String::with_capacity(t.len());
+    let mut rest = t;
+    while let Some(i) = rest.find("\\u{") {
+        out.push_str(&rest[..i]);
+        match rest[i..].find('}') {
+            Some(e) => {
+                out.push('?');
+                rest = &rest[i + e + 1..];
+            }
+            None => break,
+        }
+    }
+    out.push_str(rest);
+    out.chars()
+        .map(|c| if c.is_control() { '?' } else { c })
+        .collect()
 }
 
 fn lower_first(t: &str) -> String {
@@ -372,7 +421,10 @@ fn decoder_text(format: FileFormat, text: &str) -> Error {
             } else if lower.contains("width or height is set to zero") {
                 "its header declares a width or height of 0: the file is corrupt".into()
             } else {
-                format!("the file is corrupt ({})", lower_first(&strip_debug(t)))
+                format!(
+                    "the file is corrupt ({})",
+                    lower_first(&printable(&strip_debug(t)))
+                )
             }
         }
         FileFormat::Hdr => {
@@ -394,10 +446,16 @@ fn decoder_text(format: FileFormat, text: &str) -> Error {
             } else if lower.contains("scanline") {
                 "a run-length-encoded scanline is malformed: the file is corrupt".into()
             } else {
-                format!("the file is corrupt ({})", lower_first(&strip_debug(t)))
+                format!(
+                    "the file is corrupt ({})",
+                    lower_first(&printable(&strip_debug(t)))
+                )
             }
         }
-        _ => format!("the file is corrupt ({})", lower_first(&strip_debug(t))),
+        _ => format!(
+            "the file is corrupt ({})",
+            lower_first(&printable(&strip_debug(t)))
+        ),
     };
     decode(format, words)
 }
@@ -440,6 +498,11 @@ mod tests {
         // A tail that starts inside the scan data.
         assert!(tail_has_end_marker(&whole[11..]));
         assert!(!tail_has_end_marker(&whole[11..15]));
+    }
+
+    #[test]
+    fn control_characters_and_their_escapes_print_as_question_marks() {
+        assert_eq!(printable("a\\u{1c}b\u{7}c"), "a?b?c");
     }
 
     #[test]

@@ -168,6 +168,14 @@ impl Entry {
         }
     }
 
+    /// Whether the values lie within a file of `l.len` bytes.
+    pub fn fits(&self, l: &Layout) -> bool {
+        match self.out_of_line(l) {
+            Some((at, n)) => at.checked_add(n).is_some_and(|end| end <= l.len),
+            None => self.byte_len().is_some(),
+        }
+    }
+
     /// Where the values lie in the file when they are not in the entry.
     fn out_of_line(&self, l: &Layout) -> Option<(u64, u64)> {
         let n = self.byte_len()?;
@@ -391,7 +399,19 @@ fn read_dir(f: &mut File, l: &Layout, at: u64) -> Result<Dir, String> {
 pub(super) fn check_extents(f: &mut File, l: &Layout, dir: &Dir) -> Result<(), String> {
     // The tags the decoder reads (others it never looks at, as libtiff
     // ignores a broken private tag).
-    const READ: [u16; 12] = [
+    const READ: [u16; 24] = [
+        tag::IMAGE_WIDTH,
+        tag::IMAGE_LENGTH,
+        tag::COMPRESSION,
+        tag::PHOTOMETRIC,
+        274, // Orientation
+        tag::SAMPLES_PER_PIXEL,
+        tag::ROWS_PER_STRIP,
+        tag::PLANAR_CONFIGURATION,
+        266, // FillOrder
+        317, // Predictor
+        tag::TILE_WIDTH,
+        tag::TILE_LENGTH,
         tag::BITS_PER_SAMPLE,
         tag::STRIP_OFFSETS,
         tag::STRIP_BYTE_COUNTS,

@@ -39,12 +39,22 @@ pub(super) fn words(
         TiffError::LimitsExceeded => {
             // A tag larger than the crate's fixed limit (only while the
             // first directory is read, before parvo's limits apply)...
-            if let Some(big) = raw.and_then(|r| {
+            let big = raw.and_then(|r| {
                 r.entries
                     .iter()
-                    .map(|e| (e, e.byte_len().unwrap_or(0)))
+                    .map(|e| (e, e.byte_len().unwrap_or(u64::MAX)))
                     .find(|&(_, n)| n > CRATE_TAG_LIMIT)
-            }) {
+            });
+            if let Some((e, _)) = big
+                && !e.fits(l)
+            {
+                return corrupt(format!(
+                    "its {} tag claims {} values, more than the file holds",
+                    tag_name(e.tag),
+                    e.count
+                ));
+            }
+            if let Some(big) = big {
                 return Error::Limits(format!(
                     "the {} tag holds {} values, more than the TIFF decoder's fixed limit of 1 MiB \
                      for one tag (too many strips or tiles for it)",
@@ -107,7 +117,15 @@ pub(super) fn words(
             F::UnknownPlanarConfiguration(c) => decode_err(format!(
                 "planar configuration {c} is neither 1 (contiguous) nor 2 (planar)"
             )),
-            F::InvalidTypeForTag => corrupt("a tag has a value type TIFF does not define".into()),
+            F::InvalidTypeForTag => corrupt(
+                match raw.and_then(|r| r.entries.iter().find(|e| e.byte_len().is_none())) {
+                    Some(e) => format!(
+                        "its {} tag has a value type TIFF does not define",
+                        tag_name(e.tag)
+                    ),
+                    None => "a tag has a value type TIFF does not define".into(),
+                },
+            ),
             F::InvalidCountForTag(t, n) => corrupt(format!(
                 "the {} tag has {n} values, which does not fit the image",
                 crate_tag_name(t)
