@@ -48,7 +48,13 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     std::panic::set_hook(Box::new(|_| {}));
     let mut failed = false;
     for file in &args.files {
-        match io::load(file, &limits) {
+        // Environment maps are described, not refused (nothing is built
+        // from them here).
+        let options = io::LoadOptions {
+            environment: io::EnvironmentMaps::Describe,
+            ..Default::default()
+        };
+        match io::load_with(file, &limits, &options) {
             Ok(l) => {
                 if args.json {
                     println!("{}", json(file, &l));

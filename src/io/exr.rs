@@ -966,6 +966,40 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         }
     }
     attributes.push(("compression".into(), header.compression.to_string()));
+    // An environment map, by OpenEXR's `envmap` attribute or the
+    // `textureformat` maketx writes.
+    let texture_format = attributes
+        .iter()
+        .find(|(k, _)| k == "textureformat")
+        .map(|(_, v)| v.clone());
+    let environment = match (own.environment_map, texture_format.as_deref()) {
+        (Some(::exr::meta::attribute::EnvironmentMap::Cube), _)
+        | (None, Some("CubeFace Environment")) => Some(super::Environment::Cube),
+        (Some(::exr::meta::attribute::EnvironmentMap::LatitudeLongitude), _)
+        | (None, Some("LatLong Environment")) => Some(super::Environment::LatLong),
+        _ => None,
+    };
+    if let Some(kind) = environment {
+        let mut detail = Vec::new();
+        if let Some(t) = &texture_format {
+            detail.push(format!("textureformat \"{t}\""));
+        }
+        if let Some(e) = own.environment_map {
+            detail.push(format!(
+                "envmap {}",
+                match e {
+                    ::exr::meta::attribute::EnvironmentMap::LatitudeLongitude => "latlong",
+                    ::exr::meta::attribute::EnvironmentMap::Cube => "cube",
+                }
+            ));
+        }
+        detail.push(if kind == super::Environment::Cube && h == 6 * w {
+            format!("six {w}x{w} faces stacked top to bottom")
+        } else {
+            format!("{w}x{h}")
+        });
+        super::environment_map("OpenEXR", kind, &detail.join(", "), options, &mut notes)?;
+    }
     let data_window = header.data_window();
     let display = header.shared_attributes.display_window;
     if data_window != display {
@@ -1131,6 +1165,7 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         blocks: None,
         // OpenEXR stores linear values by definition.
         color_stated: true,
+        environment,
     };
     Ok(Loaded { levels, info })
 }

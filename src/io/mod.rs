@@ -19,6 +19,7 @@
 pub mod atomic;
 pub mod dds;
 pub mod exr;
+mod image_errors;
 pub mod ktx2;
 pub mod limits;
 pub mod png_levels;
@@ -113,6 +114,10 @@ pub struct SourceInfo {
     /// read as sRGB, a TIFF as linear. True otherwise (by the format's
     /// definition or the file's own statement).
     pub color_stated: bool,
+    /// The kind of environment map the file declares (only ever set when
+    /// [`LoadOptions::environment`] asks to describe them; see
+    /// [`EnvironmentMaps`]).
+    pub environment: Option<Environment>,
 }
 
 impl SourceInfo {
@@ -128,6 +133,7 @@ impl SourceInfo {
             notes: Vec::new(),
             blocks: None,
             color_stated: true,
+            environment: None,
         }
     }
 
@@ -233,6 +239,80 @@ pub(crate) fn recorded_wrap(text: Option<&str>, notes: &mut Vec<String>) -> Opti
     }
 }
 
+/// An environment map's projection, as OpenEXR's `envmap` attribute and
+/// the `textureformat` maketx writes name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Environment {
+    /// Latitude-longitude (equirectangular): `LatLong Environment`,
+    /// `envmap` 0.
+    LatLong,
+    /// Six cube faces in one image: `CubeFace Environment`, `envmap` 1
+    /// (OpenEXR stacks the faces top to bottom).
+    Cube,
+}
+
+impl Environment {
+    /// The kind in words ("lat-long", "cube-face").
+    pub fn name(self) -> &'static str {
+        match self {
+            Environment::LatLong => "lat-long",
+            Environment::Cube => "cube-face",
+        }
+    }
+}
+
+impl fmt::Display for Environment {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What a loader does with an environment map (a cube-face or lat-long
+/// OpenEXR or TIFF): nothing in parvo filters or samples one as what it
+/// is yet, and taking it for a plain texture filters a cube's faces
+/// into each other and wraps a lat-long map's poles, so the default
+/// refuses it. Describing it (what `parvo info` does) loads its texels
+/// as stored with [`SourceInfo::environment`] set and a note.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum EnvironmentMaps {
+    /// Refuse the file with an error naming the kind (the default).
+    #[default]
+    Refuse,
+    /// Load it as stored, marked as an environment map.
+    Describe,
+}
+
+/// Refuse an environment map of `kind` or note it, as `options` say;
+/// `detail` describes what the file holds.
+pub(crate) fn environment_map(
+    format: &'static str,
+    kind: Environment,
+    detail: &str,
+    options: &LoadOptions,
+    notes: &mut Vec<String>,
+) -> Result<()> {
+    match options.environment {
+        EnvironmentMaps::Refuse => Err(Error::Decode {
+            format,
+            reason: format!(
+                "a {kind} environment map ({detail}), which parvo cannot filter or sample yet: \
+                 filtering it as a flat image would blend {}",
+                match kind {
+                    Environment::Cube => "its six faces into each other across their edges",
+                    Environment::LatLong => "across its poles as if the image repeated vertically",
+                }
+            ),
+        }),
+        EnvironmentMaps::Describe => {
+            notes.push(format!(
+                "{kind} environment map ({detail}): described only; parvo cannot filter or \
+                 sample environment maps yet"
+            ));
+            Ok(())
+        }
+    }
+}
+
 /// Choices a loader cannot make from the file alone.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LoadOptions {
@@ -256,6 +336,9 @@ pub struct LoadOptions {
     /// while it builds). [`LoadOptions::for_sampling`] sets
     /// [`NanPolicy::Error`].
     pub nan_policy: Option<NanPolicy>,
+    /// Refuse environment maps (the default) or describe them (see
+    /// [`EnvironmentMaps`]).
+    pub environment: EnvironmentMaps,
 }
 
 impl LoadOptions {
@@ -278,6 +361,7 @@ impl Default for LoadOptions {
             auto_orient: true,
             color: None,
             nan_policy: None,
+            environment: EnvironmentMaps::Refuse,
         }
     }
 }
@@ -456,18 +540,20 @@ pub fn load_chain_stored(
 /// (1.0 linear, 1/2.2 sRGB, other exponents sRGB with a note); an `iCCP`
 /// profile is not interpreted (sRGB, with a note unless it names sRGB); no
 /// chunk at all means sRGB, at any bit depth.
-fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>, bool)> {
+fn png_transfer(path: &Path, limits: &Limits) -> Result<(ColorSpace, Option<String>, bool)> {
     let file = std::fs::File::open(path).map_err(|e| Error::Io {
         path: path.to_path_buf(),
         action: "cannot open".into(),
         error: e,
     })?;
-    let reader = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .map_err(|e| Error::Decode {
-            format: "PNG",
-            reason: e.to_string(),
-        })?;
+    let reader = png::Decoder::new_with_limits(
+        std::io::BufReader::new(file),
+        png::Limits {
+            bytes: usize::try_from(limits.max_alloc).unwrap_or(usize::MAX),
+        },
+    )
+    .read_info()
+    .map_err(|e| image_errors::png_error(limits, &e))?;
     let info = reader.info();
     if info.srgb.is_some() {
         return Ok((ColorSpace::Srgb, None, true));
@@ -517,54 +603,60 @@ fn load_image(
     overlap: Option<Overlap<'_>>,
 ) -> Result<Loaded> {
     use image::{DynamicImage, ImageDecoder, ImageFormat};
-    let decode = |reason: String| Error::Decode {
-        format: "image",
-        reason,
+    let io_err = |action: &str, e| Error::Io {
+        path: path.to_path_buf(),
+        action: action.into(),
+        error: e,
     };
     let mut reader = image::ImageReader::open(path)
-        .map_err(|e| Error::Io {
-            path: path.to_path_buf(),
-            action: "cannot open".into(),
-            error: e,
-        })?
+        .map_err(|e| io_err("cannot open", e))?
         .with_guessed_format()
-        .map_err(|e| decode(e.to_string()))?;
+        .map_err(|e| io_err("cannot read", e))?;
     let file_format = match reader.format() {
         Some(ImageFormat::Png) => FileFormat::Png,
         Some(ImageFormat::Jpeg) => FileFormat::Jpeg,
         Some(ImageFormat::Hdr) => FileFormat::Hdr,
         _ => {
-            return Err(decode(
-                "unrecognised format (parvo reads PNG, JPEG, TIFF, Radiance HDR, OpenEXR, KTX2, DDS)"
+            return Err(Error::Decode {
+                format: "input",
+                reason: "not a file format parvo reads (PNG, JPEG, TIFF, Radiance HDR, OpenEXR, \
+                         KTX2, DDS)"
                     .into(),
-            ));
+            });
         }
     };
     let mut notes = Vec::new();
     let mut color_stated = true;
     let png_cs = if file_format == FileFormat::Png {
-        let (cs, note, stated) = png_transfer(path)?;
+        let (cs, note, stated) = png_transfer(path, limits)?;
         notes.extend(note);
         color_stated = stated;
         Some(cs)
     } else {
         None
     };
-    let lim = |e: image::ImageError| match e {
-        image::ImageError::Limits(l) => Error::Limits(format!(
-            "{l} (raise with --max-width/--max-height/--max-alloc)"
-        )),
-        other => Error::Decode {
-            format: file_format.name(),
-            reason: other.to_string(),
-        },
-    };
-    reader.limits(limits.to_image());
+    if file_format == FileFormat::Jpeg {
+        // zune-jpeg decodes a file cut short without a word, as libjpeg
+        // does with a warning (and OpenImageIO without one).
+        if !image_errors::jpeg_has_end_marker(path).map_err(|e| io_err("cannot read", e))? {
+            notes.push(
+                "the JPEG ends without its end-of-image marker: it is probably truncated, and \
+                 what lies past its end is decoded from incomplete data"
+                    .into(),
+            );
+        }
+    }
+    let lim = |e: image::ImageError| image_errors::image_error(file_format, limits, e);
+    // Width and height are checked below against `limits` (whose error
+    // names the limit); the decoders keep the allocation limit.
+    let mut il = limits.to_image();
+    il.max_image_width = None;
+    il.max_image_height = None;
+    reader.limits(il);
     let mut decoder = reader.into_decoder().map_err(lim)?;
     let orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
-    let mut il = limits.to_image();
-    il.reserve(decoder.total_bytes()).map_err(lim)?;
     let (w, h) = decoder.dimensions();
+    limits.check(w as u64, h as u64, decoder.total_bytes())?;
     let ct = decoder.color_type();
     let overlap = overlap.map(|f| {
         let ch = ct.channel_count();
@@ -604,7 +696,10 @@ fn load_image(
                 decoder.read_image(&mut buf)
             })
             .map_err(lim)?;
-            let bad = || decode("decoded buffer does not match its size".into());
+            let bad = || Error::Decode {
+                format: file_format.name(),
+                reason: "the decoded image does not match its declared size".into(),
+            };
             match ct {
                 image::ColorType::L8 => DynamicImage::ImageLuma8(
                     image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,

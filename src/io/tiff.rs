@@ -7,11 +7,22 @@
 //!   `textureformat` tag (33302, which maketx writes) is a texture: its
 //!   directories are the mip levels, level 0 first. Otherwise the
 //!   directories are pages; the first is read (`--subimage N` picks
-//!   another) and a note says so.
+//!   another) and a note says so. A chain of pages that loops back on
+//!   itself is read up to the loop, with a note.
+//! - **Environment maps.** `textureformat` `CubeFace Environment` or
+//!   `LatLong Environment` (maketx `--envlatl`) marks an environment map:
+//!   it is refused unless the caller asks to describe it
+//!   ([`super::EnvironmentMaps`]).
 //! - **Alpha.** `ExtraSamples` (338) says what the channels after the
 //!   colour are: 1 associated alpha (what OpenImageIO and maketx write), 2
 //!   unassociated alpha, 0 not alpha (data). Without the tag, a second or
 //!   fourth channel is taken as associated alpha, OpenImageIO's assumption.
+//! - **Colour.** `PhotometricInterpretation` (262): BlackIsZero grey,
+//!   WhiteIsZero grey (one channel, inverted on load), RGB, or a palette
+//!   (indexed colour), expanded to 8-bit RGB through its colour map as
+//!   OpenImageIO does (entry / 257, rounded down). A file without the tag
+//!   is read as OpenImageIO reads it: grey for one channel, two data
+//!   channels for two, RGB for three or more.
 //! - **Wrap modes and tiling.** Pixar's `wrapmodes` (33303, e.g.
 //!   `black,black`) and the tile size (322, 323).
 //! - **Orientation** (274): applied on load unless turned off (see
@@ -19,25 +30,40 @@
 //!
 //! Samples of 8 and 16 bits (unsigned) and 16/32/64-bit floats load as u8,
 //! u16, f16 and f32 (f64 narrowed to f32), with one to four channels,
-//! contiguous or planar. Palette, CMYK, YCbCr, Lab, bilevel, signed and
-//! 32-bit integer samples are refused in plain words. TIFF carries no
-//! transfer function parvo reads, so `--color auto` takes its texels as
-//! linear.
+//! contiguous or planar (`PlanarConfiguration` 2, every plane read and
+//! interleaved), in strips or tiles. 1- to 7-bit grey widens to u8 as
+//! OpenImageIO widens it (`v · 255 / (2^bits − 1)` rounded down: 0 → 0,
+//! the largest code → 255). `FillOrder` 2 is read for uncompressed data.
+//! CMYK, YCbCr, Lab, LogLuv, signed, 10-, 12-, 14-, 24- and 32-bit
+//! integer samples, sub-byte colour and compressions the crate lacks
+//! (LZMA, WebP, Zstandard, CCITT Group 3) are refused in plain words.
+//! TIFF carries no transfer function parvo reads, so `--color auto` takes
+//! its texels as linear.
+//!
+//! The `tiff` crate reads the pixels; parvo walks the chain of
+//! directories itself first (`tiff/chain.rs`), which lets it read files the
+//! crate alone refuses (no photometric tag, a looping chain, palettes,
+//! tiles stored under the strip tags) and say what is wrong with a broken
+//! file in words rather than the crate's.
 
+mod chain;
+mod errors;
+
+use std::fs::File;
 use std::io::{BufReader, Read, Seek};
 use std::path::Path;
 
 use ::tiff::decoder::{Decoder, DecodingResult};
 use ::tiff::tags::Tag;
+use ::tiff::{TiffError, TiffFormatError};
 
-use super::{FileFormat, Limits, LoadOptions, Loaded, SourceInfo};
+use self::chain::{Fix, tag};
+use self::errors::{alloc_limit, words};
+use super::{Environment, FileFormat, Limits, LoadOptions, Loaded, SourceInfo};
 use crate::error::{Error, Result};
 use crate::mip::Rounding;
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
-
-const PIXAR_TEXTUREFORMAT: u16 = 33302;
-const PIXAR_WRAPMODES: u16 = 33303;
 
 fn decode_err(reason: impl std::fmt::Display) -> Error {
     Error::Decode {
@@ -46,17 +72,30 @@ fn decode_err(reason: impl std::fmt::Display) -> Error {
     }
 }
 
+/// The tag values the `tiff` crate accepts for one tag; larger ones are
+/// refused as "limits exceeded" (its default, which also applies while
+/// the first directory is read).
+const CRATE_TAG_LIMIT: u64 = 1 << 20;
+
 /// What one directory holds.
 struct Directory {
     width: u32,
     height: u32,
     format: Format,
-    /// Samples per pixel as stored (the texture keeps them all).
+    /// Channels kept (the texture's channel count).
     samples: usize,
+    /// Samples per pixel as stored.
+    stored_samples: usize,
+    bits: u16,
     planar: bool,
     tile: Option<(u32, u32)>,
     orientation: u16,
     alpha_note: Option<&'static str>,
+    /// A palette's colour map: red, green and blue tables of 2^bits
+    /// entries each.
+    palette: Option<Vec<u16>>,
+    /// FillOrder 2: the bits of every byte are stored in reverse order.
+    bit_reversed: bool,
 }
 
 fn ascii_tag<R: Read + Seek>(d: &mut Decoder<R>, tag: Tag) -> Option<String> {
@@ -66,223 +105,493 @@ fn ascii_tag<R: Read + Seek>(d: &mut Decoder<R>, tag: Tag) -> Option<String> {
     }
 }
 
-fn unsigned<R: Read + Seek>(d: &mut Decoder<R>, tag: Tag) -> Result<Option<u32>> {
-    d.find_tag_unsigned::<u32>(tag).map_err(decode_err)
+/// Reads the directory the decoder is at; `fix` says what parvo changed
+/// in it before (see [`chain::Chain::repair`]).
+struct Reader<'a> {
+    raw: &'a chain::Dir,
+    layout: chain::Layout,
+    limits: &'a Limits,
 }
 
-fn directory<R: Read + Seek>(d: &mut Decoder<R>) -> Result<Directory> {
-    let (width, height) = d.dimensions().map_err(decode_err)?;
-    let samples = unsigned(d, Tag::SamplesPerPixel)?.unwrap_or(1) as usize;
-    let bits: Vec<u16> = d
-        .find_tag_unsigned_vec::<u16>(Tag::BitsPerSample)
-        .map_err(decode_err)?
-        .unwrap_or_else(|| vec![1]);
-    let sample_format: Vec<u16> = d
-        .find_tag_unsigned_vec::<u16>(Tag::SampleFormat)
-        .map_err(decode_err)?
-        .unwrap_or_else(|| vec![1]);
-    let photometric = unsigned(d, Tag::PhotometricInterpretation)?.unwrap_or(1);
-    let planar = unsigned(d, Tag::PlanarConfiguration)?.unwrap_or(1) == 2;
-    let orientation = unsigned(d, Tag::Orientation)?.unwrap_or(1) as u16;
-    if bits.iter().any(|&b| b != bits[0]) || sample_format.iter().any(|&f| f != sample_format[0]) {
-        return Err(decode_err(
-            "channels of different bit depths or sample formats are not supported",
-        ));
+impl Reader<'_> {
+    /// A TIFF crate error while reading this directory, in words.
+    fn err(&self, e: TiffError) -> Error {
+        words(e, Some(self.raw), &self.layout, self.limits, None)
     }
-    let colour = match photometric {
-        0 | 1 => 1,
-        2 => 3,
-        3 => return Err(decode_err("palette (indexed-colour) TIFF is not supported")),
-        5 => return Err(decode_err("CMYK TIFF is not supported")),
-        6 => return Err(decode_err("YCbCr TIFF is not supported (store it as RGB)")),
-        8..=10 => return Err(decode_err("CIE L*a*b* TIFF is not supported")),
-        p => {
-            return Err(decode_err(format!(
-                "photometric interpretation {p} is not supported"
-            )));
-        }
-    };
-    if photometric == 0 {
-        return Err(decode_err(
-            "WhiteIsZero (inverted grey) TIFF is not supported",
-        ));
+
+    fn unsigned<R: Read + Seek>(&self, d: &mut Decoder<R>, tag: Tag) -> Result<Option<u32>> {
+        d.find_tag_unsigned::<u32>(tag).map_err(|e| self.err(e))
     }
-    if !(1..=4).contains(&samples) || samples < colour {
-        return Err(decode_err(format!(
-            "{samples} samples per pixel: parvo reads 1 to 4 channels"
-        )));
-    }
-    let ty = match (sample_format[0], bits[0]) {
-        (1, 8) => ChannelType::U8,
-        (1, 16) => ChannelType::U16,
-        (3, 16) => ChannelType::F16,
-        (3, 32) | (3, 64) => ChannelType::F32,
-        (1, b) if b < 8 => {
-            return Err(decode_err(format!("{b}-bit samples are not supported")));
-        }
-        (1, b) => {
+
+    fn directory<R: Read + Seek>(&self, d: &mut Decoder<R>, fix: Fix) -> Result<Directory> {
+        let (width, height) = d.dimensions().map_err(|e| self.err(e))?;
+        let stored_samples = self.unsigned(d, Tag::SamplesPerPixel)?.unwrap_or(1) as usize;
+        let bits: Vec<u16> = d
+            .find_tag_unsigned_vec::<u16>(Tag::BitsPerSample)
+            .map_err(|e| self.err(e))?
+            .unwrap_or_else(|| vec![1]);
+        let sample_format: Vec<u16> = d
+            .find_tag_unsigned_vec::<u16>(Tag::SampleFormat)
+            .map_err(|e| self.err(e))?
+            .unwrap_or_else(|| vec![1]);
+        let planar = self.unsigned(d, Tag::PlanarConfiguration)?.unwrap_or(1) == 2;
+        let orientation = self.unsigned(d, Tag::Orientation)?.unwrap_or(1) as u16;
+        if bits.is_empty() || bits.iter().any(|&b| b != bits[0]) {
             return Err(decode_err(format!(
-                "{b}-bit unsigned integer samples are not supported (8 and 16 are)"
+                "channels of different bit depths ({}) are not supported",
+                join(&bits)
             )));
         }
-        (2, b) => {
+        if sample_format.is_empty() || sample_format.iter().any(|&f| f != sample_format[0]) {
+            return Err(decode_err(
+                "channels of different sample formats (integer and float) are not supported",
+            ));
+        }
+        let bits = bits[0];
+        let extra: Vec<u16> = d
+            .find_tag_unsigned_vec::<u16>(Tag::ExtraSamples)
+            .map_err(|e| self.err(e))?
+            .unwrap_or_default();
+        let missing = fix.stored_photometric.is_none();
+        let photometric = match fix.stored_photometric {
+            Some(p) => p,
+            None => fix.told.unwrap_or(1) as u64,
+        };
+        let colour = match photometric {
+            1 | 3 => 1,
+            2 => 3,
+            // The crate inverts one WhiteIsZero channel (as libtiff
+            // and OpenImageIO read it: 0 is white).
+            0 if stored_samples == 1 && matches!(bits, 1 | 2 | 4 | 8 | 16 | 32 | 64) => 1,
+            0 if stored_samples == 1 => {
+                return Err(decode_err(format!(
+                    "WhiteIsZero (inverted grey) TIFF of {}-bit samples is not supported (1, 2, \
+                     4, 8 and 16 bits are)",
+                    bits
+                )));
+            }
+            0 => {
+                return Err(decode_err(
+                    "WhiteIsZero (inverted grey) TIFF with an alpha or extra channel is not \
+                     supported",
+                ));
+            }
+            4 => return Err(decode_err("transparency-mask TIFF is not supported")),
+            5 => return Err(decode_err("CMYK TIFF is not supported")),
+            6 => return Err(decode_err("YCbCr TIFF is not supported (store it as RGB)")),
+            8..=10 => return Err(decode_err("CIE L*a*b* TIFF is not supported")),
+            32844 | 32845 => return Err(decode_err("LogLuv (SGI) TIFF is not supported")),
+            u64::MAX => {
+                return Err(decode_err(
+                    "the PhotometricInterpretation tag does not hold one number",
+                ));
+            }
+            p => {
+                return Err(decode_err(format!(
+                    "photometric interpretation {p} is not supported"
+                )));
+            }
+        };
+        // FillOrder 2 stores the bits of each byte in reverse; libtiff
+        // reverses them before decoding, which for uncompressed data
+        // without a predictor is reversing the decoded bytes.
+        let bit_reversed = match self.unsigned(d, Tag::FillOrder)?.unwrap_or(1) {
+            1 => false,
+            2 if self.unsigned(d, Tag::Compression)?.unwrap_or(1) == 1
+                && self.unsigned(d, Tag::Predictor)?.unwrap_or(1) == 1 =>
+            {
+                true
+            }
+            2 => {
+                return Err(decode_err(
+                    "FillOrder 2 (bits stored least significant first) is supported for \
+                     uncompressed data without a predictor only",
+                ));
+            }
+            f => return Err(decode_err(format!("FillOrder {f} is neither 1 nor 2"))),
+        };
+        if !(1..=4).contains(&stored_samples) || stored_samples < colour {
             return Err(decode_err(format!(
-                "signed {b}-bit samples are not supported"
+                "{stored_samples} samples per pixel: parvo reads 1 to 4 channels"
             )));
         }
-        (f, b) => {
-            return Err(decode_err(format!(
-                "sample format {f} with {b} bits is not supported"
-            )));
-        }
-    };
-    let extra: Vec<u16> = d
-        .find_tag_unsigned_vec::<u16>(Tag::ExtraSamples)
-        .map_err(decode_err)?
-        .unwrap_or_default();
-    let has_alpha_slot = samples == 2 || samples == 4;
-    let (alpha, alpha_note) = if samples > colour {
-        match extra.first() {
-            Some(1) => (AlphaMode::Premultiplied, None),
-            Some(2) => (AlphaMode::Straight, None),
-            Some(_) => (AlphaMode::None, None),
-            None if has_alpha_slot => (
-                AlphaMode::Premultiplied,
-                Some(
-                    "no ExtraSamples tag: the last channel is taken as associated alpha, as \
-                     OpenImageIO does (--alpha straight or none overrides)",
+        let palette = if photometric == 3 {
+            if stored_samples != 1 || !matches!(bits, 1 | 2 | 4 | 8 | 16) || sample_format[0] != 1 {
+                return Err(decode_err(format!(
+                    "a palette image of {stored_samples} samples of {bits} bits is not supported \
+                     (one index of 1, 2, 4, 8 or 16 bits is)"
+                )));
+            }
+            let map = d
+                .find_tag_unsigned_vec::<u16>(Tag::ColorMap)
+                .map_err(|e| self.err(e))?
+                .ok_or_else(|| decode_err("a palette image without a ColorMap tag"))?;
+            let want = 3usize << bits;
+            if map.len() != want {
+                return Err(decode_err(format!(
+                    "the ColorMap has {} entries, a palette of {bits}-bit indices has {want}",
+                    map.len()
+                )));
+            }
+            Some(map)
+        } else {
+            None
+        };
+        let ty = match (sample_format[0], bits) {
+            _ if palette.is_some() => ChannelType::U8,
+            (1, 1..=7) if stored_samples == 1 => ChannelType::U8,
+            (1, 8) => ChannelType::U8,
+            (1, 16) => ChannelType::U16,
+            (3, 16) => ChannelType::F16,
+            (3, 32) | (3, 64) => ChannelType::F32,
+            (1, b) if b < 8 => {
+                return Err(decode_err(format!(
+                    "{b}-bit samples are supported for one grey channel, not for {stored_samples} \
+                     channels"
+                )));
+            }
+            (1, b) => {
+                return Err(decode_err(format!(
+                    "{b}-bit unsigned integer samples are not supported (8 and 16 are)"
+                )));
+            }
+            (2, b) => {
+                return Err(decode_err(format!(
+                    "signed {b}-bit samples are not supported"
+                )));
+            }
+            (f, b) => {
+                return Err(decode_err(format!(
+                    "sample format {f} with {b} bits is not supported"
+                )));
+            }
+        };
+        let has_alpha_slot = stored_samples == 2 || stored_samples == 4;
+        let (alpha, alpha_note) = if missing && stored_samples == 2 && extra.is_empty() {
+            // OpenImageIO reads two untagged channels as R, G data.
+            (AlphaMode::None, None)
+        } else if stored_samples > colour {
+            match extra.first() {
+                Some(1) => (AlphaMode::Premultiplied, None),
+                Some(2) => (AlphaMode::Straight, None),
+                Some(_) => (AlphaMode::None, None),
+                None if has_alpha_slot => (
+                    AlphaMode::Premultiplied,
+                    Some(
+                        "no ExtraSamples tag: the last channel is taken as associated alpha, as \
+                         OpenImageIO does (--alpha straight or none overrides)",
+                    ),
                 ),
-            ),
-            None => (AlphaMode::None, None),
+                None => (AlphaMode::None, None),
+            }
+        } else {
+            (AlphaMode::Straight, None)
+        };
+        let alpha = if has_alpha_slot {
+            alpha
+        } else {
+            AlphaMode::Straight
+        };
+        // The `tiff` crate returns RGB without a fourth sample that is not
+        // alpha; that channel cannot be read.
+        let (samples, alpha_note) = if colour == 3
+            && stored_samples == 4
+            && alpha == AlphaMode::None
+        {
+            (
+                3,
+                Some("the fourth channel is not alpha (ExtraSamples 0) and is not read; RGB is"),
+            )
+        } else if palette.is_some() {
+            (3, alpha_note)
+        } else {
+            (stored_samples, alpha_note)
+        };
+        let tile = match (
+            self.unsigned(d, Tag::TileWidth)?,
+            self.unsigned(d, Tag::TileLength)?,
+        ) {
+            (Some(w), Some(h)) => Some((w, h)),
+            _ => None,
+        };
+        Ok(Directory {
+            width,
+            height,
+            format: Format::new(samples as u8, ty, ColorSpace::Linear).with_alpha(alpha),
+            samples,
+            stored_samples,
+            bits,
+            planar,
+            tile,
+            orientation,
+            alpha_note,
+            palette,
+            bit_reversed,
+        })
+    }
+
+    /// Decode the directory the decoder is at: every plane of a planar
+    /// file, interleaved; sub-byte grey widened; palette indices mapped.
+    fn texture<R: Read + Seek>(&self, d: &mut Decoder<R>, dir: &Directory) -> Result<Texture> {
+        let (w, h) = (dir.width as usize, dir.height as usize);
+        let n = w * h;
+        let err = |e| words(e, Some(self.raw), &self.layout, self.limits, Some(dir));
+        let sample_bytes = (dir.bits as usize).div_ceil(8);
+        let (mut result, per_pixel) = if dir.planar && dir.tile.is_some() && dir.stored_samples > 1
+        {
+            let need = (n as u64)
+                .saturating_mul(dir.stored_samples as u64)
+                .saturating_mul(sample_bytes as u64);
+            if need > self.limits.max_alloc {
+                return Err(alloc_limit(self.limits, dir, need));
+            }
+            (planar_tiles(d, dir).map_err(err)?, dir.stored_samples)
+        } else {
+            let mut result = DecodingResult::U8(Vec::new());
+            let layout = d.read_image_to_buffer(&mut result).map_err(err)?;
+            if result.as_buffer(0).byte_len() < layout.complete_len {
+                // The crate reads only the first plane when all of them do
+                // not fit its decoding buffer (the allocation limit).
+                return Err(alloc_limit(self.limits, dir, layout.complete_len as u64));
+            }
+            let per_pixel = if dir.planar {
+                layout.planes
+            } else {
+                layout.complete_len / (n * sample_bytes).max(1)
+            };
+            (result, per_pixel)
+        };
+        if dir.bit_reversed {
+            for b in result.as_buffer(0).as_bytes_mut() {
+                *b = b.reverse_bits();
+            }
         }
-    } else {
-        (AlphaMode::Straight, None)
-    };
-    let alpha = if has_alpha_slot {
-        alpha
-    } else {
-        AlphaMode::Straight
-    };
-    // The `tiff` crate returns RGB without a fourth sample that is not
-    // alpha; that channel cannot be read.
-    let (samples, alpha_note) = if colour == 3 && samples == 4 && alpha == AlphaMode::None {
-        (
-            3,
-            Some("the fourth channel is not alpha (ExtraSamples 0) and is not read; RGB is"),
-        )
-    } else {
-        (samples, alpha_note)
-    };
-    let tile = match (unsigned(d, Tag::TileWidth)?, unsigned(d, Tag::TileLength)?) {
-        (Some(w), Some(h)) => Some((w, h)),
-        _ => None,
-    };
-    Ok(Directory {
-        width,
-        height,
-        format: Format::new(samples as u8, ty, ColorSpace::Linear).with_alpha(alpha),
-        samples,
-        planar,
-        tile,
-        orientation,
-        alpha_note,
+        // Channels decoded per pixel and kept (a palette has one index).
+        let keep = if dir.palette.is_some() {
+            1
+        } else {
+            dir.samples
+        };
+        if dir.bits >= 8 && per_pixel < keep {
+            return Err(decode_err(format!(
+                "the decoder returned {per_pixel} samples per pixel, the tags declare {keep}"
+            )));
+        }
+        let pick = (n, per_pixel, keep, dir.planar);
+        let texels = match result {
+            DecodingResult::U8(v) if dir.bits < 8 => {
+                let idx = unpack(&v, w, h, dir.bits as u32)?;
+                match &dir.palette {
+                    Some(map) => Texels::U8(expand_palette(&idx, map, 1 << dir.bits)),
+                    None => {
+                        Texels::U8(idx.into_iter().map(|i| widen(i, dir.bits as u32)).collect())
+                    }
+                }
+            }
+            DecodingResult::U8(v) => match &dir.palette {
+                Some(map) => Texels::U8(expand_palette(&select(v, pick)?, map, 256)),
+                None => Texels::U8(select(v, pick)?),
+            },
+            DecodingResult::U16(v) => match &dir.palette {
+                Some(map) => Texels::U8(expand_palette(&select(v, pick)?, map, 65536)),
+                None => Texels::U16(select(v, pick)?),
+            },
+            DecodingResult::F16(v) => Texels::F16(select(v, pick)?),
+            DecodingResult::F32(v) => Texels::F32(select(v, pick)?),
+            DecodingResult::F64(v) => {
+                Texels::F32(select(v, pick)?.into_iter().map(|x| x as f32).collect())
+            }
+            _ => {
+                return Err(decode_err(
+                    "the decoder returned a sample type parvo does not read",
+                ));
+            }
+        };
+        Texture::from_texels(dir.width, dir.height, dir.format, texels)
+    }
+}
+
+/// Every plane of a tiled planar image, plane after plane, read tile by
+/// tile: the `tiff` crate's whole-image read of tiled planar files
+/// overruns its buffer at the bottom tiles of the planes after the first
+/// (it clips only the first plane's tiles to the image).
+fn planar_tiles<R: Read + Seek>(
+    d: &mut Decoder<R>,
+    dir: &Directory,
+) -> std::result::Result<DecodingResult, TiffError> {
+    let (w, h) = (dir.width as usize, dir.height as usize);
+    let (tw, th) = d.chunk_dimensions();
+    let (tw, th) = (tw as usize, th as usize);
+    let (across, down) = (w.div_ceil(tw), h.div_ceil(th));
+    let bytes = (dir.bits as usize).div_ceil(8);
+    let plane = w * h * bytes;
+    let mut out = vec![0u8; plane * dir.stored_samples];
+    let mut kind = None;
+    for p in 0..dir.stored_samples {
+        for ty in 0..down {
+            for tx in 0..across {
+                let index = (p * across * down + ty * across + tx) as u32;
+                let chunk = d.read_chunk(index)?;
+                kind.get_or_insert(match &chunk {
+                    DecodingResult::U8(_) => 0,
+                    DecodingResult::U16(_) => 1,
+                    DecodingResult::F16(_) => 2,
+                    DecodingResult::F32(_) => 3,
+                    _ => 4,
+                });
+                let mut chunk = chunk;
+                let src = chunk.as_buffer(0);
+                let src = src.as_bytes();
+                // Rows of the tile inside the image, each as wide as the
+                // tile's part inside the image.
+                let cw = tw.min(w - tx * tw);
+                let rows = th.min(h - ty * th);
+                let row = cw * bytes;
+                if src.len() < rows * row {
+                    return Err(TiffError::FormatError(
+                        TiffFormatError::InconsistentSizesEncountered,
+                    ));
+                }
+                for r in 0..rows {
+                    let at = p * plane + ((ty * th + r) * w + tx * tw) * bytes;
+                    out[at..at + row].copy_from_slice(&src[r * row..(r + 1) * row]);
+                }
+            }
+        }
+    }
+    Ok(match kind {
+        Some(0) | None => DecodingResult::U8(out),
+        Some(1) => DecodingResult::U16(bytemuck::pod_collect_to_vec(&out)),
+        Some(2) => DecodingResult::F16(bytemuck::pod_collect_to_vec(&out)),
+        Some(3) => DecodingResult::F32(bytemuck::pod_collect_to_vec(&out)),
+        _ => DecodingResult::F64(bytemuck::pod_collect_to_vec(&out)),
     })
 }
 
-/// The first `want` samples of a decoded image, interleaved when the file
-/// is planar.
-fn take<T: Copy>(mut v: Vec<T>, want: usize, planar: bool, samples: usize, n: usize) -> Vec<T> {
-    v.truncate(want);
-    if planar { interleave(v, samples, n) } else { v }
+/// The first `keep` of the `per_pixel` samples of each of `n` pixels,
+/// interleaved (a planar image holds all of channel 0, then channel 1, ...).
+/// `pick` is (n, per_pixel, keep, planar).
+fn select<T: Copy>(v: Vec<T>, pick: (usize, usize, usize, bool)) -> Result<Vec<T>> {
+    let (n, per_pixel, keep, planar) = pick;
+    if v.len() < n * per_pixel {
+        return Err(decode_err(format!(
+            "the decoder returned {} samples, the tags declare {}",
+            v.len(),
+            n * per_pixel
+        )));
+    }
+    Ok(match (planar, per_pixel == keep) {
+        (false, true) => {
+            let mut v = v;
+            v.truncate(n * keep);
+            v
+        }
+        (false, false) => v
+            .chunks_exact(per_pixel)
+            .take(n)
+            .flat_map(|px| px[..keep].iter().copied())
+            .collect(),
+        (true, _) if keep == 1 => {
+            let mut v = v;
+            v.truncate(n);
+            v
+        }
+        (true, _) => {
+            let mut out = Vec::with_capacity(n * keep);
+            for i in 0..n {
+                for c in 0..keep {
+                    out.push(v[c * n + i]);
+                }
+            }
+            out
+        }
+    })
 }
 
-/// Interleave planar data (all of channel 0, then channel 1, ...).
-fn interleave<T: Copy>(v: Vec<T>, ch: usize, n: usize) -> Vec<T> {
-    if ch == 1 {
-        return v;
+/// A `bits`-bit code widened to 8 bits: `v · 255 / (2^bits − 1)`
+/// rounded down (0 → 0, the largest code → 255; exact for 1, 2 and 4
+/// bits), as OpenImageIO widens them.
+fn widen(v: u8, bits: u32) -> u8 {
+    let max = (1u32 << bits) - 1;
+    (v as u32 * 255 / max) as u8
+}
+
+pub(super) fn join(v: &[u16]) -> String {
+    v.iter()
+        .map(|b| b.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// One value per pixel from rows of `bits`-bit values (1 to 8) packed
+/// most significant bit first, each row starting on a byte.
+fn unpack(packed: &[u8], w: usize, h: usize, bits: u32) -> Result<Vec<u8>> {
+    let stride = (w * bits as usize).div_ceil(8);
+    if packed.len() < stride * h {
+        return Err(decode_err(format!(
+            "the decoder returned {} bytes, {h} rows of {w} {bits}-bit values take {}",
+            packed.len(),
+            stride * h
+        )));
     }
-    let mut out = Vec::with_capacity(n * ch);
-    for i in 0..n {
-        for c in 0..ch {
-            out.push(v[c * n + i]);
+    let mask = (1u16 << bits) - 1;
+    let mut out = Vec::with_capacity(w * h);
+    for row in packed.chunks_exact(stride).take(h) {
+        for x in 0..w {
+            let bit = x * bits as usize;
+            // The value's bits within the two bytes it may straddle.
+            let pair = ((row[bit / 8] as u16) << 8) | *row.get(bit / 8 + 1).unwrap_or(&0) as u16;
+            let shift = 16 - bits as usize - bit % 8;
+            out.push(((pair >> shift) & mask) as u8);
         }
+    }
+    Ok(out)
+}
+
+/// RGB u8 texels of palette indices: each colour-map entry (16 bits)
+/// divided by 257 and rounded down, as OpenImageIO converts them.
+fn expand_palette<I: Copy + Into<usize>>(idx: &[I], map: &[u16], size: usize) -> Vec<u8> {
+    let to8 = |v: u16| (v / 257) as u8;
+    let mut out = Vec::with_capacity(idx.len() * 3);
+    for &i in idx {
+        let i: usize = i.into();
+        out.extend_from_slice(&[to8(map[i]), to8(map[size + i]), to8(map[2 * size + i])]);
     }
     out
 }
 
-fn read_texture<R: Read + Seek>(d: &mut Decoder<R>, dir: &Directory) -> Result<Texture> {
-    let n = dir.width as usize * dir.height as usize;
-    let want = n * dir.samples;
-    let result = d.read_image().map_err(decode_err)?;
-    let check = |len: usize| {
-        if len < want {
-            Err(decode_err(format!(
-                "decoded {len} samples, a {}x{} image of {} channels has {want}{}",
-                dir.width,
-                dir.height,
-                dir.samples,
-                if dir.planar {
-                    " (planar files whose planes do not all decode are not supported)"
-                } else {
-                    ""
-                }
-            )))
-        } else {
-            Ok(())
-        }
-    };
-    let len = match &result {
-        DecodingResult::U8(v) => v.len(),
-        DecodingResult::U16(v) => v.len(),
-        DecodingResult::F16(v) => v.len(),
-        DecodingResult::F32(v) => v.len(),
-        DecodingResult::F64(v) => v.len(),
-        _ => return Err(decode_err("unexpected sample type from the decoder")),
-    };
-    check(len)?;
-    let (planar, samples) = (dir.planar, dir.samples);
-    let texels = match result {
-        DecodingResult::U8(v) => Texels::U8(take(v, want, planar, samples, n)),
-        DecodingResult::U16(v) => Texels::U16(take(v, want, planar, samples, n)),
-        DecodingResult::F16(v) => Texels::F16(take(v, want, planar, samples, n)),
-        DecodingResult::F32(v) => Texels::F32(take(v, want, planar, samples, n)),
-        DecodingResult::F64(v) => Texels::F32(take(
-            v.into_iter().map(|x| x as f32).collect(),
-            want,
-            planar,
-            samples,
-            n,
-        )),
-        _ => return Err(decode_err("unexpected sample type from the decoder")),
-    };
-    Texture::from_texels(dir.width, dir.height, dir.format, texels)
+/// The environment-map kind a `textureformat` names.
+fn environment(texture_format: Option<&str>) -> Option<Environment> {
+    match texture_format? {
+        "CubeFace Environment" => Some(Environment::Cube),
+        "LatLong Environment" => Some(Environment::LatLong),
+        _ => None,
+    }
 }
 
 /// Load a TIFF file (see the module docs).
 pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loaded> {
-    let file = std::fs::File::open(path).map_err(|e| Error::Io {
-        path: path.to_path_buf(),
-        action: "cannot open".into(),
-        error: e,
-    })?;
-    let mut tl = ::tiff::decoder::Limits::default();
-    tl.decoding_buffer_size = usize::try_from(limits.max_alloc).unwrap_or(usize::MAX);
-    tl.intermediate_buffer_size = tl.decoding_buffer_size;
-    let mut d = Decoder::new(BufReader::new(file))
-        .map_err(decode_err)?
-        .with_limits(tl);
-    let texture_format = ascii_tag(&mut d, Tag::Unknown(PIXAR_TEXTUREFORMAT));
-    let mipmapped = texture_format.is_some();
-    let mut notes = Vec::new();
-    // Count the directories (cheap: the IFD chain, not the pixels).
-    let mut pages = 1usize;
-    while d.more_images() {
-        d.next_image().map_err(decode_err)?;
-        pages += 1;
-        if pages > 4096 {
-            return Err(decode_err("more than 4096 directories"));
-        }
-    }
+    let open = || {
+        File::open(path).map_err(|e| Error::Io {
+            path: path.to_path_buf(),
+            action: "cannot open".into(),
+            error: e,
+        })
+    };
+    let mut file = open()?;
+    let len = file
+        .metadata()
+        .map_err(|e| Error::Io {
+            path: path.to_path_buf(),
+            action: "cannot read".into(),
+            error: e,
+        })?
+        .len();
+    let chain = chain::walk(&mut file, len).map_err(decode_err)?;
+    let l = chain.layout;
+    let pages = chain.dirs.len();
+    let texture_format = chain.dirs[0].entry(tag::TEXTURE_FORMAT).is_some();
+    let mipmapped = texture_format;
     let first = if mipmapped { 0 } else { options.subimage };
     if first >= pages {
         return Err(Error::InvalidOption(format!(
@@ -295,14 +604,48 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
             "--subimage: this TIFF is a mip-mapped texture, its directories are its levels".into(),
         ));
     }
+    let count = if mipmapped { pages } else { 1 };
+    for d in &chain.dirs[first..first + count] {
+        chain::check_extents(&mut file, &l, d).map_err(decode_err)?;
+    }
+    let (view, fixes, fix_notes) = chain.repair(open()?).map_err(decode_err)?;
+    let mut notes = Vec::new();
     if !mipmapped && pages > 1 {
         notes.push(format!(
             "multi-page TIFF: using page {first} of {pages}; --subimage N picks another"
         ));
     }
-    d.seek_to_image(first).map_err(decode_err)?;
-    let dir0 = directory(&mut d)?;
-    let wrap_text = ascii_tag(&mut d, Tag::Unknown(PIXAR_WRAPMODES));
+    notes.extend(chain.notes.iter().cloned());
+    if mipmapped {
+        notes.extend(fix_notes);
+    } else {
+        // Only the page read.
+        let prefix = format!("page {first}: ");
+        notes.extend(
+            fix_notes
+                .into_iter()
+                .filter(|n| pages == 1 || n.starts_with(&prefix))
+                .map(|n| n.trim_start_matches(&prefix).to_string()),
+        );
+    }
+    let reader = |k: usize| Reader {
+        raw: &chain.dirs[k],
+        layout: l,
+        limits,
+    };
+    let mut tl = ::tiff::decoder::Limits::default();
+    tl.decoding_buffer_size = usize::try_from(limits.max_alloc).unwrap_or(usize::MAX);
+    tl.intermediate_buffer_size = tl.decoding_buffer_size;
+    tl.ifd_value_size =
+        usize::try_from(len.min(limits.max_alloc).max(CRATE_TAG_LIMIT)).unwrap_or(usize::MAX);
+    let mut d = Decoder::new(BufReader::new(view))
+        .map_err(|e| reader(0).err(e))?
+        .with_limits(tl);
+    d.seek_to_image(first).map_err(|e| reader(first).err(e))?;
+    let r0 = reader(first);
+    let dir0 = r0.directory(&mut d, fixes[first])?;
+    let texture_format = ascii_tag(&mut d, Tag::Unknown(tag::TEXTURE_FORMAT));
+    let wrap_text = ascii_tag(&mut d, Tag::Unknown(tag::WRAP_MODES));
     let mut attributes: Vec<(String, String)> = Vec::new();
     for (name, tag) in [
         ("ImageDescription", Tag::ImageDescription),
@@ -320,7 +663,7 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     if let Some(w) = &wrap_text {
         attributes.push(("wrapmodes".into(), w.clone()));
     }
-    if let Some(c) = unsigned(&mut d, Tag::Compression)? {
+    if let Some(c) = r0.unsigned(&mut d, Tag::Compression)? {
         let name = match c {
             1 => "none".to_string(),
             5 => "lzw".into(),
@@ -335,8 +678,22 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
         attributes.push(("Orientation".into(), dir0.orientation.to_string()));
     }
     attributes.sort();
+    let env = environment(texture_format.as_deref());
+    if let Some(kind) = env {
+        super::environment_map(
+            "TIFF",
+            kind,
+            &format!(
+                "textureformat \"{}\", {}x{}",
+                texture_format.as_deref().unwrap_or(""),
+                dir0.width,
+                dir0.height
+            ),
+            options,
+            &mut notes,
+        )?;
+    }
     // Declared sizes of every level read, checked before decoding.
-    let count = if mipmapped { pages } else { 1 };
     let full = crate::mip::level_count(dir0.width, dir0.height, Rounding::Down, None) as usize;
     let up = crate::mip::level_count(dir0.width, dir0.height, Rounding::Up, None) as usize;
     if count > full.max(up) {
@@ -356,11 +713,21 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     if let Some(n) = dir0.alpha_note {
         notes.push(n.to_string());
     }
-    let mut levels = vec![read_texture(&mut d, &dir0)?];
+    if let Some(map) = &dir0.palette
+        && map.iter().any(|&v| v % 257 != 0)
+    {
+        notes.push(
+            "palette TIFF: the colour map's 16-bit entries are rounded down to 8 bits, as \
+             OpenImageIO reads them"
+                .into(),
+        );
+    }
+    let mut levels = vec![r0.texture(&mut d, &dir0)?];
     let mut rounding = Rounding::Down;
-    for k in 1..count {
-        d.seek_to_image(k).map_err(decode_err)?;
-        let dir = directory(&mut d)?;
+    for (k, &fix) in fixes.iter().enumerate().take(count).skip(1) {
+        d.seek_to_image(k).map_err(|e| reader(k).err(e))?;
+        let rk = reader(k);
+        let dir = rk.directory(&mut d, fix)?;
         if k == 1 {
             let up_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Up);
             let down_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Down);
@@ -377,7 +744,7 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
                 dir.width, dir.height, dir.format, want.0, want.1, dir0.format
             )));
         }
-        levels.push(read_texture(&mut d, &dir)?);
+        levels.push(rk.texture(&mut d, &dir)?);
     }
     if dir0.orientation != 1 {
         if options.auto_orient {
@@ -402,6 +769,67 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     info.wrap = super::recorded_wrap(wrap_text.as_deref(), &mut notes);
     info.tile = dir0.tile;
     info.attributes = attributes;
+    info.environment = env;
     info.notes = notes;
+    // TIFF names no transfer parvo reads: its values are taken as they
+    // are (linear), as OpenImageIO reads them, and that is an assumption.
+    info.color_stated = false;
     Ok(Loaded { levels, info })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unpack_reads_rows_msb_first_each_on_a_byte() {
+        // 5 pixels of 2 bits: 00 01 10 11 | 01 (row padded to 2 bytes).
+        let rows = [0b0001_1011, 0b0100_0000, 0b1110_0100, 0b1000_0000];
+        assert_eq!(
+            unpack(&rows, 5, 2, 2).unwrap(),
+            [0, 1, 2, 3, 1, 3, 2, 1, 0, 2]
+        );
+        assert!(unpack(&rows[..3], 5, 2, 2).is_err());
+    }
+
+    #[test]
+    fn palette_entries_round_down_as_openimageio() {
+        // Values checked against OpenImageIO 3.2 reading a palette TIFF.
+        let mut map = vec![0u16; 3 * 4];
+        map[..4].copy_from_slice(&[0xFF00, 0x8000, 0x0100, 0xFFFF]);
+        let rgb = expand_palette(&[0u8, 1, 2, 3], &map, 4);
+        assert_eq!(
+            rgb.iter().step_by(3).copied().collect::<Vec<_>>(),
+            [254, 127, 0, 255]
+        );
+    }
+
+    #[test]
+    fn planar_samples_interleave_and_extra_ones_drop() {
+        let v = vec![1, 2, 3, 10, 20, 30, 100, 200, 300, 7, 7, 7];
+        assert_eq!(
+            select(v.clone(), (3, 4, 3, true)).unwrap(),
+            [1, 10, 100, 2, 20, 200, 3, 30, 300]
+        );
+        assert_eq!(
+            select(v.clone(), (3, 4, 3, false)).unwrap(),
+            [1, 2, 3, 20, 30, 100, 300, 7, 7]
+        );
+        assert!(select(v, (4, 4, 3, true)).is_err());
+    }
+
+    #[test]
+    fn sub_byte_codes_widen_as_openimageio() {
+        for bits in 1..=7u32 {
+            let max = (1u8 << bits) - 1;
+            assert_eq!(widen(0, bits), 0);
+            assert_eq!(widen(max, bits), 255, "{bits} bits");
+        }
+        // 1, 2 and 4 bits scale exactly.
+        assert_eq!(widen(1, 2), 85);
+        assert_eq!(widen(7, 4), 119);
+        // 6 bits: codes OpenImageIO 3.2 read from libtiff's
+        // flower-minisblack-06.tif (16 → 64, 32 → 129, 62 → 250).
+        assert_eq!([widen(16, 6), widen(32, 6), widen(62, 6)], [64, 129, 250]);
+    }
 }

@@ -141,3 +141,99 @@ pub enum TagValue {
     Short(Vec<u16>),
     Ascii(String),
 }
+
+/// One directory of a TIFF written byte by byte by [`write_raw_tiff`]
+/// (independent of the `tiff` crate and of parvo, so a test can write
+/// what neither writes: planar data, a missing tag, a looping chain).
+pub struct RawIfd {
+    /// Tags and their SHORT (3) or LONG (4) values, or ASCII (2) text as
+    /// bytes; the strip or tile offsets and byte counts are added.
+    pub entries: Vec<(u16, u16, Vec<u32>)>,
+    /// The strips (or tiles), in file order.
+    pub chunks: Vec<Vec<u8>>,
+    /// Tiles (TileOffsets/TileByteCounts) rather than strips.
+    pub tiled: bool,
+}
+
+/// A little-endian classic TIFF of `ifds`, each directory pointing to the
+/// next; the last points back to directory `loop_to` when given.
+pub fn write_raw_tiff(path: &Path, ifds: &[RawIfd], loop_to: Option<usize>) {
+    let mut out: Vec<u8> = b"II*\0\0\0\0\0".to_vec();
+    let mut dir_at = Vec::new();
+    let mut next_field = Vec::new();
+    for ifd in ifds {
+        let mut offsets = Vec::new();
+        for c in &ifd.chunks {
+            offsets.push(out.len() as u32);
+            out.extend_from_slice(c);
+            if out.len() % 2 == 1 {
+                out.push(0);
+            }
+        }
+        let (o, c) = if ifd.tiled { (324, 325) } else { (273, 279) };
+        let mut entries = ifd.entries.clone();
+        entries.push((o, 4, offsets));
+        entries.push((c, 4, ifd.chunks.iter().map(|c| c.len() as u32).collect()));
+        entries.sort_by_key(|e| e.0);
+        let at = out.len();
+        dir_at.push(at as u32);
+        let values_at = at + 2 + 12 * entries.len() + 4;
+        let mut values = Vec::new();
+        let mut dir = (entries.len() as u16).to_le_bytes().to_vec();
+        for (tag, ty, v) in &entries {
+            let bytes: Vec<u8> = match ty {
+                2 => v.iter().map(|&b| b as u8).collect(),
+                3 => v.iter().flat_map(|&x| (x as u16).to_le_bytes()).collect(),
+                _ => v.iter().flat_map(|&x| x.to_le_bytes()).collect(),
+            };
+            dir.extend_from_slice(&tag.to_le_bytes());
+            dir.extend_from_slice(&ty.to_le_bytes());
+            dir.extend_from_slice(&(v.len() as u32).to_le_bytes());
+            if bytes.len() <= 4 {
+                let mut f = bytes.clone();
+                f.resize(4, 0);
+                dir.extend_from_slice(&f);
+            } else {
+                dir.extend_from_slice(&((values_at + values.len()) as u32).to_le_bytes());
+                values.extend_from_slice(&bytes);
+                if values.len() % 2 == 1 {
+                    values.push(0);
+                }
+            }
+        }
+        next_field.push(out.len() + dir.len());
+        dir.extend_from_slice(&[0; 4]);
+        out.extend_from_slice(&dir);
+        out.extend_from_slice(&values);
+    }
+    out[4..8].copy_from_slice(&dir_at[0].to_le_bytes());
+    for k in 1..ifds.len() {
+        let f = next_field[k - 1];
+        out[f..f + 4].copy_from_slice(&dir_at[k].to_le_bytes());
+    }
+    if let Some(to) = loop_to {
+        let f = next_field[ifds.len() - 1];
+        out[f..f + 4].copy_from_slice(&dir_at[to].to_le_bytes());
+    }
+    std::fs::write(path, out).unwrap();
+}
+
+/// A fixed-seed generator of test data (SplitMix64).
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+}
+
+/// The path of a peer project's test file under tests/data/peer/.
+pub fn peer(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/peer")
+        .join(name)
+}

@@ -1,0 +1,125 @@
+//! Issue 27 #12: OpenEXR environment maps (`envmap` cube or lat-long,
+//! `textureformat` "CubeFace Environment" / "LatLong Environment", as
+//! openexr-images' KernerEnvCube.exr and KernerEnvLatLong.exr) were
+//! silently flattened: `parvo mip` filtered a cube's six-face strip as one
+//! image, blending the faces into each other, and wrote it back as "Plain
+//! Texture" with periodic wrap. parvo cannot filter environment maps yet,
+//! so `mip` now refuses them with an error naming the kind, and `info`
+//! still reads them and says what they are. A maketx `.tx` environment
+//! map (TIFF) is treated the same.
+
+use crate::util::{TagValue, ok, parvo, s, write_tiff_u8};
+use exr::prelude::*;
+
+/// A tiled RGBA half EXR of `w`×`h` (the Kerner files' channels and
+/// tiling; they are mip-mapped too) with the given layer attributes.
+fn env_exr(path: &std::path::Path, w: usize, h: usize, attrs: LayerAttributes) {
+    let layer = Layer::new(
+        (w, h),
+        attrs,
+        Encoding {
+            compression: Compression::ZIP16,
+            blocks: Blocks::Tiles(Vec2(8, 8)),
+            line_order: LineOrder::Increasing,
+        },
+        SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
+            // Each cube face its own colour.
+            let face = (y / w) as f32;
+            (
+                f16::from_f32(face / 6.0),
+                f16::from_f32(x as f32 / w as f32),
+                f16::from_f32(0.5),
+                f16::ONE,
+            )
+        }),
+    );
+    Image::from_layer(layer).write().to_file(path).unwrap();
+}
+
+fn refused_by_mip_and_described_by_info(src: &std::path::Path, kind: &str) {
+    let out = src.with_extension("out.ktx2");
+    let r = parvo(&["mip", s(src), "-o", s(&out)]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1), "mip must refuse: {err}");
+    assert!(
+        err.contains(&format!("{kind} environment map")),
+        "the error names the kind: {err}"
+    );
+    assert!(!out.exists(), "nothing is written");
+    let j: serde_json::Value =
+        serde_json::from_str(&ok(&parvo(&["info", "--json", s(src)]))).unwrap();
+    assert_eq!(j["status"], "ok");
+    let notes = j["notes"].to_string();
+    assert!(
+        notes.contains(&format!("{kind} environment map")),
+        "info says what it is: {notes}"
+    );
+}
+
+#[test]
+fn a_cube_face_exr_is_refused_by_mip_and_described_by_info() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("cube.exr");
+    let attrs = LayerAttributes {
+        environment_map: Some(attribute::EnvironmentMap::Cube),
+        ..LayerAttributes::default()
+    };
+    env_exr(&src, 16, 96, attrs);
+    refused_by_mip_and_described_by_info(&src, "cube-face");
+    let j: serde_json::Value =
+        serde_json::from_str(&ok(&parvo(&["info", "--json", s(&src)]))).unwrap();
+    // The six faces are read as stored, not cropped or padded.
+    assert_eq!(
+        (j["width"].as_u64(), j["height"].as_u64()),
+        (Some(16), Some(96))
+    );
+    assert!(j["notes"].to_string().contains("six 16x16 faces"));
+}
+
+#[test]
+fn a_lat_long_exr_named_by_textureformat_is_refused_by_mip() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("latlong.exr");
+    let mut attrs = LayerAttributes::default();
+    attrs.other.insert(
+        Text::from("textureformat"),
+        AttributeValue::Text(Text::from("LatLong Environment")),
+    );
+    env_exr(&src, 32, 16, attrs);
+    refused_by_mip_and_described_by_info(&src, "lat-long");
+}
+
+#[test]
+fn a_maketx_environment_tiff_is_refused_by_mip() {
+    use tiff::encoder::colortype::RGB8;
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("env.tx");
+    let dirs: Vec<(u32, u32, Vec<u8>)> = [(8u32, 4u32), (4, 2), (2, 1), (1, 1)]
+        .iter()
+        .map(|&(w, h)| (w, h, vec![100; (w * h * 3) as usize]))
+        .collect();
+    write_tiff_u8::<RGB8>(
+        &src,
+        &dirs,
+        &[(33302, TagValue::Ascii("LatLong Environment".into()))],
+    );
+    refused_by_mip_and_described_by_info(&src, "lat-long");
+}
+
+#[test]
+fn a_plain_texture_exr_is_not_taken_for_an_environment_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("plain.exr");
+    let mut attrs = LayerAttributes::default();
+    attrs.other.insert(
+        Text::from("textureformat"),
+        AttributeValue::Text(Text::from("Plain Texture")),
+    );
+    env_exr(&src, 16, 8, attrs);
+    ok(&parvo(&[
+        "mip",
+        s(&src),
+        "-o",
+        s(&dir.path().join("o.exr")),
+    ]));
+}
