@@ -148,10 +148,14 @@ impl Reader<'_> {
             ));
         }
         let bits = bits[0];
-        let extra: Vec<u16> = d
+        let mut extra: Vec<u16> = d
             .find_tag_unsigned_vec::<u16>(Tag::ExtraSamples)
             .map_err(|e| self.err(e))?
             .unwrap_or_default();
+        // The decoder was told the data sample is alpha (see Fix).
+        if fix.extra_data {
+            extra = vec![0];
+        }
         let missing = fix.stored_photometric.is_none();
         let photometric = match fix.stored_photometric {
             Some(p) => p,
@@ -293,20 +297,21 @@ impl Reader<'_> {
             AlphaMode::Straight
         };
         // The `tiff` crate returns RGB without a fourth sample that is not
-        // alpha; that channel cannot be read.
-        let (samples, alpha_note) = if colour == 3
-            && stored_samples == 4
-            && alpha == AlphaMode::None
-        {
-            (
-                3,
-                Some("the fourth channel is not alpha (ExtraSamples 0) and is not read; RGB is"),
-            )
-        } else if palette.is_some() {
-            (3, alpha_note)
-        } else {
-            (stored_samples, alpha_note)
-        };
+        // alpha; one such sample stated inline is read (the crate is told
+        // it is alpha, see Fix), any other cannot be.
+        let (samples, alpha_note) =
+            if colour == 3 && stored_samples == 4 && alpha == AlphaMode::None && !fix.extra_data {
+                (
+                    3,
+                    Some(
+                        "the fourth channel is not alpha (ExtraSamples 0) and is not read; RGB is",
+                    ),
+                )
+            } else if palette.is_some() {
+                (3, alpha_note)
+            } else {
+                (stored_samples, alpha_note)
+            };
         let tile = match (
             self.unsigned(d, Tag::TileWidth)?,
             self.unsigned(d, Tag::TileLength)?,

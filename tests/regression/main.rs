@@ -41,4 +41,5 @@ mod sample_ignores_recorded_wrap_modes;
 mod sat_rect_end_just_below_zero_read_a_texel_off;
 mod subcommand_long_help_hidden;
 mod tiff_associated_alpha_premultiplied_twice;
+mod tiff_rgb_data_sample_dropped;
 mod tiff_untagged_and_looping_refused;

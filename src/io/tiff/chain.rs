@@ -241,6 +241,11 @@ pub(super) struct Fix {
     /// for palette indices, which parvo maps through the colour map
     /// itself; the value OpenImageIO assumes for a missing tag.
     pub told: Option<u16>,
+    /// The fourth sample of an RGB directory is data (`ExtraSamples` 0):
+    /// the decoder is told it is unassociated alpha (2), since the crate
+    /// drops a sample it does not take for alpha, and parvo reads it back
+    /// as data.
+    pub extra_data: bool,
 }
 
 /// The directories of a file up to the first repeated one (or the end of
@@ -658,12 +663,21 @@ impl Chain {
                 .is_some_and(|n| n > l.offset_size());
                 (e.count > samples && fits).then_some(samples)
             });
+            // RGB with one extra sample that is data (ExtraSamples 0,
+            // one value inline): the crate reads RGB only.
+            let rgb = matches!(stored_photometric.or(told.map(u64::from)), Some(2));
+            let extra_data = rgb
+                && samples == 4
+                && d.entry(tag::EXTRA_SAMPLES)
+                    .is_some_and(|e| e.count == 1 && e.inline_unsigned(l) == Some(0));
             fixes.push(Fix {
                 stored_photometric,
                 told,
+                extra_data,
             });
             let last = k + 1 == self.dirs.len();
-            let next_at = if told.is_some() || tiles_as_strips || bits_count.is_some() {
+            let next_at = if told.is_some() || tiles_as_strips || bits_count.is_some() || extra_data
+            {
                 let mut entries: Vec<Entry> = d
                     .entries
                     .iter()
@@ -672,6 +686,11 @@ impl Chain {
                     .collect();
                 if let Some(v) = told {
                     entries.push(Entry::short(l, tag::PHOTOMETRIC, v));
+                }
+                if extra_data {
+                    for e in entries.iter_mut().filter(|e| e.tag == tag::EXTRA_SAMPLES) {
+                        *e = Entry::short(l, tag::EXTRA_SAMPLES, 2);
+                    }
                 }
                 if let Some(n) = bits_count {
                     for e in entries.iter_mut().filter(|e| e.tag == tag::BITS_PER_SAMPLE) {
