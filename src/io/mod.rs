@@ -510,6 +510,46 @@ fn png_transfer(path: &Path) -> Result<(ColorSpace, Option<String>, bool)> {
     Ok((ColorSpace::Srgb, None, false))
 }
 
+/// What a PNG's chunks before the image data say that the `image` decoder
+/// does not apply (see [`png_extras`]).
+#[derive(Debug, Default)]
+struct PngExtras {
+    /// For 1-, 2- and 4-bit grey whose `tRNS` grey lies beyond the bit
+    /// depth: the expanded 8-bit grey that is transparent. libpng (so
+    /// OpenImageIO) keeps the sample's low bits, as the PNG specification
+    /// says a sample is stored; the `png` decoder compares the whole low
+    /// byte and so makes nothing transparent.
+    grey_trns: Option<u8>,
+}
+
+/// Read the chunks before a PNG's image data for what [`PngExtras`]
+/// holds. A file whose header does not read gives nothing (the decoder
+/// reports it).
+fn png_extras(path: &Path) -> PngExtras {
+    let mut out = PngExtras::default();
+    let Ok(file) = std::fs::File::open(path) else {
+        return out;
+    };
+    let Ok(reader) = png::Decoder::new(std::io::BufReader::new(file)).read_info() else {
+        return out;
+    };
+    let info = reader.info();
+    if info.color_type == png::ColorType::Grayscale
+        && let Some(&[low]) = info.trns.as_deref()
+    {
+        let max = match info.bit_depth {
+            png::BitDepth::One => 1u8,
+            png::BitDepth::Two => 3,
+            png::BitDepth::Four => 15,
+            _ => 255,
+        };
+        if low > max {
+            out.grey_trns = Some((low & max) * (255 / max));
+        }
+    }
+    out
+}
+
 fn load_image(
     path: &Path,
     limits: &Limits,
@@ -550,6 +590,11 @@ fn load_image(
     } else {
         None
     };
+    let extras = if file_format == FileFormat::Png {
+        png_extras(path)
+    } else {
+        PngExtras::default()
+    };
     let lim = |e: image::ImageError| match e {
         image::ImageError::Limits(l) => Error::Limits(format!(
             "{l} (raise with --max-width/--max-height/--max-alloc)"
@@ -575,7 +620,7 @@ fn load_image(
         };
         move || f(w, h, ch, ty)
     });
-    let img = match ct {
+    let mut img = match ct {
         // 8-bit images (the common large case) are decoded into a buffer
         // whose pages another thread maps meanwhile (`mem::populate`):
         // the decoder runs on one core, and first touches of a 16384²
@@ -628,6 +673,11 @@ fn load_image(
         })
         .map_err(lim)?,
     };
+    if let (Some(t), DynamicImage::ImageLumaA8(b)) = (extras.grey_trns, &mut img) {
+        for px in b.chunks_exact_mut(2) {
+            px[1] = if px[0] == t { 0 } else { u8::MAX };
+        }
+    }
     let (w, h) = (img.width(), img.height());
     let f = |ch: u8, ty: ChannelType| {
         let cs = match (file_format, png_cs) {

@@ -29,6 +29,7 @@ mod maketx_tx_read_as_one_level;
 mod multipart_and_multipage_silently_first;
 mod normal_maps_filtered_as_encoded_codes;
 mod pillow_bc1_dds_refused;
+mod png_1bit_trns_alpha_ignored;
 mod png_colour_chunks_ignored;
 mod premultiplied_exr_written_premultiplied_to_png;
 mod readme_said_built_fuzz_targets_were_missing;
