@@ -520,17 +520,53 @@ struct PngExtras {
     /// says a sample is stored; the `png` decoder compares the whole low
     /// byte and so makes nothing transparent.
     grey_trns: Option<u8>,
+    /// The orientation tag of the `eXIf` chunk, if it has one.
+    exif_orientation: Option<u16>,
+    /// The orientation tag of the EXIF block ImageMagick stores as hex in
+    /// a `Raw profile type exif` text chunk, if it has one.
+    text_orientation: Option<u16>,
+    /// What was not understood, one sentence each.
+    notes: Vec<String>,
+}
+
+/// The text of ImageMagick's raw profile form (`\nexif\n<length>\n<hex>`):
+/// the EXIF block as bytes from its TIFF header on, when the text is one.
+/// As OpenImageIO and Pillow read it: hex digits after the length, other
+/// characters skipped; the block's `Exif\0\0` prefix dropped (Pillow also
+/// takes a block that starts with the TIFF header).
+fn raw_profile_exif(text: &str) -> Option<Vec<u8>> {
+    let rest = text.trim_start().strip_prefix("exif")?.trim_start();
+    let end = rest
+        .find(|c: char| !c.is_ascii_digit())
+        .unwrap_or(rest.len());
+    let declared: usize = rest[..end].parse().ok().filter(|&n| n > 0)?;
+    let nibbles: Vec<u8> = rest[end..]
+        .chars()
+        .filter_map(|c| c.to_digit(16).map(|d| d as u8))
+        .collect();
+    let mut bytes: Vec<u8> = nibbles.chunks_exact(2).map(|p| p[0] << 4 | p[1]).collect();
+    bytes.truncate(declared);
+    if bytes.len() >= 6 && bytes[..4].eq_ignore_ascii_case(b"Exif") {
+        Some(bytes.split_off(6))
+    } else if bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*") {
+        Some(bytes)
+    } else {
+        None
+    }
 }
 
 /// Read the chunks before a PNG's image data for what [`PngExtras`]
 /// holds. A file whose header does not read gives nothing (the decoder
 /// reports it).
 fn png_extras(path: &Path) -> PngExtras {
+    use image::metadata::Orientation;
     let mut out = PngExtras::default();
     let Ok(file) = std::fs::File::open(path) else {
         return out;
     };
-    let Ok(reader) = png::Decoder::new(std::io::BufReader::new(file)).read_info() else {
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    decoder.set_ignore_text_chunk(false);
+    let Ok(reader) = decoder.read_info() else {
         return out;
     };
     let info = reader.info();
@@ -545,6 +581,51 @@ fn png_extras(path: &Path) -> PngExtras {
         };
         if low > max {
             out.grey_trns = Some((low & max) * (255 / max));
+        }
+    }
+    let tag = |exif: &[u8]| Orientation::from_exif_chunk(exif).map(|o| o.to_exif() as u16);
+    out.exif_orientation = info.exif_metadata.as_deref().and_then(tag);
+    const KEY: &str = "Raw profile type exif";
+    // The text can be large (an EXIF thumbnail); a profile beyond this is
+    // not read.
+    const LIMIT: usize = 16 << 20;
+    let texts = info
+        .uncompressed_latin1_text
+        .iter()
+        .filter(|t| t.keyword.eq_ignore_ascii_case(KEY))
+        .map(|t| Some(t.text.clone()))
+        .chain(
+            info.compressed_latin1_text
+                .iter()
+                .filter(|t| t.keyword.eq_ignore_ascii_case(KEY))
+                .map(|t| {
+                    let mut t = t.clone();
+                    t.decompress_text_with_limit(LIMIT).ok()?;
+                    t.get_text().ok()
+                }),
+        )
+        .chain(
+            info.utf8_text
+                .iter()
+                .filter(|t| t.keyword.eq_ignore_ascii_case(KEY))
+                .map(|t| {
+                    let mut t = t.clone();
+                    t.decompress_text_with_limit(LIMIT).ok()?;
+                    t.get_text().ok()
+                }),
+        );
+    for text in texts {
+        match text.as_deref().map(raw_profile_exif) {
+            Some(Some(exif)) => {
+                out.text_orientation = out.text_orientation.or_else(|| tag(&exif));
+            }
+            Some(None) => out.notes.push(format!(
+                "the `{KEY}` text chunk is not an EXIF block in ImageMagick's hex form: ignored"
+            )),
+            None => out.notes.push(format!(
+                "the compressed `{KEY}` text chunk does not inflate (damaged, or beyond 16 MiB): \
+                 ignored"
+            )),
         }
     }
     out
@@ -595,6 +676,7 @@ fn load_image(
     } else {
         PngExtras::default()
     };
+    notes.extend(extras.notes.iter().cloned());
     let lim = |e: image::ImageError| match e {
         image::ImageError::Limits(l) => Error::Limits(format!(
             "{l} (raise with --max-width/--max-height/--max-alloc)"
@@ -606,7 +688,14 @@ fn load_image(
     };
     reader.limits(limits.to_image());
     let mut decoder = reader.into_decoder().map_err(lim)?;
-    let orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
+    let mut orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
+    // A PNG's `eXIf` tag first, else ImageMagick's text form (OpenImageIO
+    // reads both, the chunk last).
+    if extras.exif_orientation.is_none()
+        && let Some(o) = extras.text_orientation
+    {
+        orientation = o;
+    }
     let mut il = limits.to_image();
     il.reserve(decoder.total_bytes()).map_err(lim)?;
     let (w, h) = decoder.dimensions();

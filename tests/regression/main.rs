@@ -31,6 +31,7 @@ mod normal_maps_filtered_as_encoded_codes;
 mod pillow_bc1_dds_refused;
 mod png_1bit_trns_alpha_ignored;
 mod png_colour_chunks_ignored;
+mod png_imagemagick_exif_ignored;
 mod premultiplied_exr_written_premultiplied_to_png;
 mod readme_said_built_fuzz_targets_were_missing;
 mod roughness_map_ringing_went_below_zero;
