@@ -22,6 +22,7 @@ mod info_json_silent_on_failure;
 mod ktx2_bc3_srgb_dfd_fails_ktx_validate;
 mod ktx2_dds_errors_give_numbers_not_names;
 mod ktx2_dfd_block_dimension_255_panicked;
+mod ktx2_orientation_up_ignored;
 mod ktx2_supercompressed_levels_bypassed_max_alloc;
 mod ktx2_two_channel_read_as_grey_alpha;
 mod level_template_ignores_extension;
