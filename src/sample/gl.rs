@@ -178,6 +178,10 @@ pub(crate) fn gradient_plan(lod: &Lod, o: &SamplerOptions, q: &Query, bias: f32)
     level_plan(lod, o, base as f32)
 }
 
+/// Up to four texel indices (`None` = border), their weights, and how
+/// many are used.
+type Taps = ([Option<(u32, u32)>; 4], [f32; 4], usize);
+
 /// Taps of one texel filter at `(u, v)` (already in the first wrap
 /// period) on level `l`: up to four wrapped indices (`None` = border) and
 /// their weights, in the bilinear order (i0,j0), (i1,j0), (i0,j1),
@@ -189,7 +193,7 @@ fn taps<P: Pixel>(
     u: f64,
     v: f64,
     a: &Addressing,
-) -> ([Option<(u32, u32)>; 4], [f32; 4], usize) {
+) -> Taps {
     let at = |i: i64, j: i64| match (wrap_index(a.wrap.u, i, l.w), wrap_index(a.wrap.v, j, l.h)) {
         (Some(x), Some(y)) => Some((x, y)),
         _ => None,

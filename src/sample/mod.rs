@@ -84,6 +84,7 @@ mod ewa_simd;
 pub mod fetch;
 pub mod footprint;
 pub mod gl;
+mod one;
 mod query;
 #[cfg(target_arch = "x86_64")]
 mod simd;
@@ -566,6 +567,9 @@ pub struct Sampler {
     addr: Addressing,
     lod: Lod,
     sat: Option<Arc<SatSampler>>,
+    /// What [`Sampler::sample`] and [`Sampler::sample_quad`] run (see
+    /// `one.rs`).
+    paths: one::Paths,
     /// The chain's level table for the AVX-512 path, when it can run.
     #[cfg(target_arch = "x86_64")]
     simd: Option<simd::LevelTable>,
@@ -649,6 +653,7 @@ impl Sampler {
             },
             lod,
             sat: None,
+            paths: one::pick(kernel, &options),
             #[cfg(target_arch = "x86_64")]
             simd,
         })
@@ -714,7 +719,7 @@ impl Sampler {
     /// Filtered linear RGBA colour at `q`.
     #[inline]
     pub fn sample(&self, q: &Query) -> [f32; 4] {
-        self.sample_traced(q, &mut NoTrace)
+        (self.paths.one)(self, &self.lod, &self.options, q)
     }
 
     /// Filtered colour at `(u, v)` on the explicit level `level` (GLSL
@@ -739,10 +744,8 @@ impl Sampler {
             Kernel::Isotropic | Kernel::Texel => {
                 let mut o = self.options;
                 o.lod_bias += bias;
-                let mut s = self.clone();
-                s.lod = Lod::new(&o, self.lod.wf, self.lod.hf, self.chain.len());
-                s.options = o;
-                s.sample(q)
+                let lod = Lod::new(&o, self.lod.wf, self.lod.hf, self.chain.len());
+                (self.paths.one)(self, &lod, &o, q)
             }
             _ => {
                 let k = (bias as f64).exp2() as f32;
@@ -768,7 +771,14 @@ impl Sampler {
     /// sampler's mag/min/mip filters, isotropically (GLSL `textureGrad` on
     /// a `sampler2DShadow`, WGSL `textureSampleCompare`; see [`gl`]).
     pub fn sample_compare(&self, q: &Query, reference: f32, op: CompareOp) -> f32 {
-        let plan = gl::gradient_plan(&self.lod, &self.options, q, 0.0);
+        self.sample_compare_bias(q, reference, op, 0.0)
+    }
+
+    /// [`Sampler::sample_compare`] with a shader LOD bias added to the
+    /// sampler's (GLSL `texture(sampler2DShadow, p, bias)`; WGSL has no
+    /// biased compare).
+    pub fn sample_compare_bias(&self, q: &Query, reference: f32, op: CompareOp, bias: f32) -> f32 {
+        let plan = gl::gradient_plan(&self.lod, &self.options, q, bias);
         self.compare_plan(&plan, q.u, q.v, reference, op)
     }
 
@@ -797,10 +807,7 @@ impl Sampler {
     /// bottom-right), their derivatives taken inside the quad as a GPU
     /// does ([`quad_queries`]).
     pub fn sample_quad(&self, uv: &[[f32; 2]; 4]) -> [[f32; 4]; 4] {
-        let qs = quad_queries(uv);
-        let mut out = [[0.0; 4]; 4];
-        self.run(&qs, &mut out, &mut NoTrace);
-        out
+        (self.paths.quad)(self, &quad_queries(uv))
     }
 
     fn probe_plan(&self, plan: &footprint::Plan, u: f32, v: f32) -> [f32; 4] {

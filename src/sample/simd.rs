@@ -987,16 +987,6 @@ pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
     // At most 16 probes per query.
     const MAX_PROBES: usize = 16 * super::BLOCK;
     const MAX_BLOCKS: usize = MAX_PROBES / 8;
-    let ls = Levels::new(table);
-    let mut staged = [Staged::EMPTY; MAX_BLOCKS];
-    let mut probes = Probes {
-        u: [0.0; MAX_PROBES],
-        v: [0.0; MAX_PROBES],
-        hi: [0; MAX_PROBES],
-        lo: [0; MAX_PROBES],
-        delta: [0.0; MAX_PROBES],
-    };
-    let mut colour = [[0f32; 4]; MAX_PROBES];
     for (qs, os) in queries
         .chunks(super::BLOCK)
         .zip(out.chunks_mut(super::BLOCK))
@@ -1010,8 +1000,45 @@ pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
         for (s, q) in st[done..].iter_mut().zip(rest) {
             *s = aniso::setup::<Lin, MIP>(lod, opts, q);
         }
+        // SAFETY: as this function's.
+        unsafe {
+            probes_of::<P, MIP, MAX_PROBES, MAX_BLOCKS>(c, table, a, &st[..qs.len()], os);
+        }
+    }
+}
+
+/// The probes of the footprint-assembly lookups set up in `st` (at most
+/// `NP / 16` of them; `NB = NP / 8`), into `out`: packed 8 to a block
+/// (probes of different lookups share a block, so lanes are not wasted
+/// on lookups with few probes), staged before they are read (see
+/// [`Staged`]), then each lookup's probes summed in probe order. The
+/// batch path runs it 16 lookups at a time, `Sampler::sample` on one and
+/// `Sampler::sample_quad` on a quad's four.
+///
+/// # Safety
+/// As [`isotropic`].
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+pub(crate) unsafe fn probes_of<P: Pixel, const MIP: u8, const NP: usize, const NB: usize>(
+    c: &Chain<P>,
+    table: &LevelTable,
+    a: &Addressing,
+    st: &[Setup],
+    out: &mut [[f32; 4]],
+) {
+    let ls = Levels::new(table);
+    let mut staged = [Staged::EMPTY; NB];
+    let mut probes = Probes {
+        u: [0.0; NP],
+        v: [0.0; NP],
+        hi: [0; NP],
+        lo: [0; NP],
+        delta: [0.0; NP],
+    };
+    let mut colour = [[0f32; 4]; NP];
+    {
+        let os = out;
         let mut np = 0;
-        for s in &st[..qs.len()] {
+        for s in st {
             let n = s.probes.max(1);
             let step = 1.0 / (n as f64 + 1.0);
             for i in 1..=n {
@@ -1035,7 +1062,7 @@ pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
             } else {
                 ((1u16 << (np - 8 * k)) - 1) as u8
             };
-            stage_probes::<P, MIP, MAX_PROBES>(&ls, &probes, 8 * k, live, s);
+            stage_probes::<P, MIP, NP>(&ls, &probes, 8 * k, live, s);
         }
         for (s, col) in staged[..nb].iter().zip(colour.chunks_exact_mut(8)) {
             for h in 0..2 {
@@ -1048,7 +1075,7 @@ pub(crate) unsafe fn anisotropic<P: Pixel, const MIP: u8>(
             }
         }
         let mut k = 0;
-        for (s, o) in st[..qs.len()].iter().zip(os.iter_mut()) {
+        for (s, o) in st.iter().zip(os.iter_mut()) {
             let n = s.probes.max(1) as usize;
             // Probes the first pass left out, the portable way.
             for i in k..k + n {
