@@ -88,7 +88,10 @@ pub struct SampleArgs {
         long,
         value_name = "L",
         allow_negative_numbers = true,
-        long_help = "Sample every query on this explicit level, as GLSL textureLod / WGSL         textureSampleLevel do: the derivative columns are read but ignored, the sampler's         --lod-bias and --lod-min/--lod-max apply, and the --mag/--min/--mip filters choose the         texels (no anisotropy). With --compare, the comparison is made on that level."
+        long_help = "Sample every query on this explicit level, as GLSL textureLod / WGSL \
+        textureSampleLevel do: the derivative columns are read but ignored, the sampler's \
+        --lod-bias and --lod-min/--lod-max apply, and the --mag/--min/--mip filters choose the \
+        texels (no anisotropy). With --compare, the comparison is made on that level."
     )]
     level: Option<f32>,
     /// Shader LOD bias added to --lod-bias for every query (texture(s, p, bias)).
@@ -97,7 +100,9 @@ pub struct SampleArgs {
         value_name = "B",
         allow_negative_numbers = true,
         conflicts_with = "level",
-        long_help = "A shader LOD bias, as GLSL texture(s, p, bias) / WGSL textureSampleBias take         it: added to the sampler's --lod-bias for every query (λ = log2(ρ) + lod-bias + bias, then         the clamps)."
+        long_help = "A shader LOD bias, as GLSL texture(s, p, bias) / WGSL textureSampleBias take \
+        it: added to the sampler's --lod-bias for every query (λ = log2(ρ) + lod-bias + bias, then \
+        the clamps)."
     )]
     bias: Option<f32>,
     /// Print component C (0-3) of the 4 texels of the bilinear footprint (textureGather).
@@ -106,14 +111,23 @@ pub struct SampleArgs {
         value_name = "C",
         value_parser = clap::value_parser!(u8).range(0..=3),
         conflicts_with_all = ["compare", "level", "bias"],
-        long_help = "Print, per query, component C (0-3) of the four texels a bilinear lookup of         level 0 reads, in GL's textureGather order: (i0,j1) (i1,j1) (i1,j0) (i0,j0), j growing         with v; wrapped as the sampler wraps, the border colour's component outside the level         under `border`. Values are decoded (sRGB to linear). Derivatives are ignored."
+        long_help = "Print, per query, component C (0-3) of the four texels a bilinear lookup of \
+        level 0 reads, in GL's textureGather order: (i0,j1) (i1,j1) (i1,j0) (i0,j0), j growing \
+        with v; wrapped as the sampler wraps, the border colour's component outside the level \
+        under `border`. Values are decoded (sRGB to linear). Derivatives are ignored."
     )]
     gather: Option<u8>,
     /// Depth comparison: a 7th column per query is the reference; prints the filtered result.
     #[arg(
         long,
         value_name = "OP",
-        long_help = "Depth comparison, as GLSL textureGrad on a sampler2DShadow (textureLod with         --level): each query line has a 7th column, the reference depth; channel 0 of every texel         read is compared (reference OP texel: never, less, equal, lequal, greater, notequal, gequal,         always), the 0/1 results filtered by --mag/--min/--mip isotropically, and one value printed         per query. The reference is clamped to [0, 1] for 8- and 16-bit textures, as GL clamps it         for fixed-point depth."
+        long_help = "Depth comparison, as GLSL textureGrad on a sampler2DShadow (textureLod with \
+        --level): each query line has a 7th column, the reference depth; channel 0 of every texel \
+        read is compared (reference OP texel: never, less, equal, lequal, greater, notequal, gequal, \
+        always), the 0/1 results filtered by --mag/--min/--mip isotropically, and one value printed \
+        per query; --bias adds a shader bias as texture(sampler2DShadow, p, bias) does. The \
+        reference is clamped to [0, 1] for 8- and 16-bit textures, as GL clamps it \
+        for fixed-point depth."
     )]
     compare: Option<CompareOp>,
 }
@@ -126,14 +140,16 @@ enum Mode {
     Level(f32),
     Bias(f32),
     Gather(usize),
-    Compare(CompareOp, Option<f32>),
+    /// Depth comparison on an explicit level, or with gradients and a
+    /// shader bias (0 without `--bias`).
+    Compare(CompareOp, Option<f32>, f32),
 }
 
 impl SampleArgs {
     fn mode(&self) -> Mode {
         match (self.gather, self.compare, self.level, self.bias) {
             (Some(c), ..) => Mode::Gather(c as usize),
-            (None, Some(op), l, _) => Mode::Compare(op, l),
+            (None, Some(op), l, b) => Mode::Compare(op, l, b.unwrap_or(0.0)),
             (None, None, Some(l), _) => Mode::Level(l),
             (None, None, None, Some(b)) => Mode::Bias(b),
             _ => Mode::Sample,
@@ -300,10 +316,10 @@ fn stream(
                         Mode::Gather(c) => {
                             format_colour(&mut text, &sampler.gather(q.u, q.v, c), 4)
                         }
-                        Mode::Compare(op, level) => {
+                        Mode::Compare(op, level, bias) => {
                             let x = match level {
                                 Some(l) => sampler.sample_compare_level(q.u, q.v, l, *r, op),
-                                None => sampler.sample_compare(q, *r, op),
+                                None => sampler.sample_compare_bias(q, *r, op, bias),
                             };
                             format_colour(&mut text, &[x; 4], 1)
                         }
