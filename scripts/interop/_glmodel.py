@@ -139,9 +139,13 @@ def lambda_of(q, w, h, explicit_lod, bias, lod_min, lod_max, lod_model):
 
 def sample(levels, q, call, mag="linear", min="linear", mip="none", wrap=("repeat", "repeat"),
            border=(0.0, 0.0, 0.0, 0.0), lod_bias=0.0, lod_min=-1000.0, lod_max=1000.0,
-           compare=None, lod_model="exact"):
+           compare=None, lod_model="exact", ties=None):
     """The GL result of texture function `call` (as _llvmpipe.GL.CALLS names
-    them) per query: N x 4 for colour and gather, N x 1 for shadow lookups."""
+    them) per query: N x 4 for colour and gather, N x 1 for shadow lookups.
+    `ties` is the nearest-level rounding at d' = k + ½: "preferred"
+    (⌈d' + ½⌉ − 1) or "even"; by default the one `lod_model` names."""
+    if ties is None:
+        ties = "preferred" if lod_model == "exact" else "even"
     u, v = q[:, 0], q[:, 1]
     if call.startswith("gather"):
         c = int(call[-1])
@@ -164,7 +168,7 @@ def sample(levels, q, call, mag="linear", min="linear", mip="none", wrap=("repea
         stack = np.stack(per_level)  # L x N x C
         n = np.arange(len(q))
         if mip == "nearest":
-            if lod_model == "exact":
+            if ties == "preferred":
                 k = np.where(d <= 0.5, 0, np.ceil(d + 0.5) - 1).astype(np.int64)
             else:
                 k = np.rint(d).astype(np.int64)  # ties to even

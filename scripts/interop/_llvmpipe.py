@@ -75,7 +75,10 @@ class GL:
         import moderngl
 
         self.mgl = moderngl
-        self.ctx = moderngl.create_standalone_context(require=450, backend="egl")
+        # The runtime sonames (libEGL.so.1, libGL.so.1), not the unversioned
+        # names of the -dev packages, which a fresh machine may lack.
+        self.ctx = moderngl.create_standalone_context(require=450, backend="egl", libegl="libEGL.so.1",
+                                                      libgl="libGL.so.1")
         self.renderer = self.ctx.info["GL_RENDERER"]
         self.version = self.ctx.info["GL_VERSION"]
         egl = ctypes.CDLL("libEGL.so.1")
