@@ -61,6 +61,7 @@ from pathlib import Path
 import numpy as np
 import OpenImageIO as oiio
 
+sys.dont_write_bytecode = True  # no __pycache__ of the helper modules in the checkout
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _glmodel as model  # noqa: E402
 from _llvmpipe import fragment_derivatives  # noqa: E402  (numpy only; GL loads on use)
