@@ -222,6 +222,8 @@ class Tally:
         self.shown = []
         self.errors = []
         self.widened = 0
+        self.same = 0  # lookups where both sides' rules give one result
+        self.same_worst = 0.0
 
     def add(self, what, q, got, want, allow, base=None):
         got = np.asarray(got, np.float64)
@@ -230,6 +232,10 @@ class Tally:
         over = diff > allow
         if base is not None:
             self.widened += int((diff > base).sum())
+            same = np.asarray(allow) - base <= 1e-12
+            self.same += int(same.sum())
+            if same.any():
+                self.same_worst = max(self.same_worst, float(diff[same].max()))
         self.total += len(q)
         self.bad += int(over.sum())
         i = int(np.argmax(diff - allow))
@@ -249,7 +255,9 @@ class Tally:
                    f"allowed {allowance}"
                    + (f"; {self.widened} of them differ by more than {TOL:g}, within that change"
                       if self.widened else "")
-                   + (f"; {self.bad} over" if self.bad else ""))
+                   + (f"; {self.bad} over" if self.bad else "")
+                   + (f"; max |diff| {self.same_worst:.3g} over the {self.same} where both rules give "
+                      f"one result" if self.same else ""))
         for s in self.shown:
             print("       " + s)
         return ok
