@@ -140,3 +140,41 @@ fn a_call_bias_equals_the_sampler_bias() {
         }
     }
 }
+
+/// `sample_rgba8` is `sample` encoded in the texture's colour space:
+/// against the sRGB formula in f64 (IEC 61966-2-1) for the colour of an
+/// sRGB texture, x·255 for alpha and linear textures, rounded to nearest
+/// after clamping to [0, 1] (values within 1e-4 of a rounding tie are
+/// skipped: f32 against f64).
+#[test]
+fn encoded_output_is_the_colour_space_formula() {
+    let mut r = Rng(0x8b17);
+    for format in [
+        Format::new(4, ChannelType::U8, ColorSpace::Srgb),
+        Format::new(4, ChannelType::F32, ColorSpace::Linear),
+    ] {
+        let tex = common::random_texture(&mut r, 33, 17, format);
+        let chain = mip::build(tex, &MipOptions::default()).unwrap();
+        let s = Sampler::new(&chain, SamplerOptions::trilinear()).unwrap();
+        let srgb = format.color_space == ColorSpace::Srgb;
+        let mut checked = 0;
+        for q in quads(&mut r, 500).iter().flat_map(quad_queries) {
+            let lin = s.sample(&q);
+            let enc = s.sample_rgba8(&q);
+            for k in 0..4 {
+                let x = (lin[k] as f64).clamp(0.0, 1.0);
+                let e = if srgb && k < 3 {
+                    common::srgb_encode(x)
+                } else {
+                    x
+                } * 255.0;
+                if (e - e.floor() - 0.5).abs() < 1e-4 {
+                    continue;
+                }
+                assert_eq!(enc[k], e.round() as u8, "{format:?} channel {k} of {lin:?}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 7000, "{checked}");
+    }
+}

@@ -722,6 +722,32 @@ impl Sampler {
         (self.paths.one)(self, &self.lod, &self.options, q)
     }
 
+    /// [`Sampler::sample`] encoded to 8 bits in the texture's own colour
+    /// space (sRGB colour channels for an sRGB texture, alpha always
+    /// linear), rounded to nearest, clamped to [0, 1] (NaN reads 0): what a
+    /// renderer writes to an RGBA8 framebuffer. The filtering itself stays
+    /// in linear light.
+    pub fn sample_rgba8(&self, q: &Query) -> [u8; 4] {
+        self.encode_rgba8(self.sample(q))
+    }
+
+    /// A linear RGBA colour encoded as [`Sampler::sample_rgba8`] encodes it.
+    pub fn encode_rgba8(&self, c: [f32; 4]) -> [u8; 4] {
+        let srgb = self.chain.format().color_space == crate::texel::ColorSpace::Srgb;
+        let lin = |x: f32| {
+            #[allow(clippy::manual_clamp)]
+            let x = x.max(0.0).min(1.0);
+            (x * 255.0 + 0.5) as u8
+        };
+        std::array::from_fn(|k| {
+            if srgb && k < 3 {
+                crate::texel::srgb::encode_u8(c[k])
+            } else {
+                lin(c[k])
+            }
+        })
+    }
+
     /// Filtered colour at `(u, v)` on the explicit level `level` (GLSL
     /// `textureLod`, WGSL `textureSampleLevel`): the sampler's bias and LOD
     /// clamps apply, its mag/min/mip filters choose the texels, there is no
