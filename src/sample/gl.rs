@@ -187,13 +187,7 @@ type Taps = ([Option<(u32, u32)>; 4], [f32; 4], usize);
 /// their weights, in the bilinear order (i0,j0), (i1,j0), (i0,j1),
 /// (i1,j1); nearest has one tap of weight 1.
 #[inline]
-fn taps<P: Pixel>(
-    l: &Level<P>,
-    filter: TexelFilter,
-    u: f64,
-    v: f64,
-    a: &Addressing,
-) -> Taps {
+fn taps<P: Pixel>(l: &Level<P>, filter: TexelFilter, u: f64, v: f64, a: &Addressing) -> Taps {
     let at = |i: i64, j: i64| match (wrap_index(a.wrap.u, i, l.w), wrap_index(a.wrap.v, j, l.h)) {
         (Some(x), Some(y)) => Some((x, y)),
         _ => None,
