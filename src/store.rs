@@ -135,13 +135,19 @@ impl TextureStore {
             .map_err(|e| crate::Error::InvalidOption(e.clone()))
     }
 
+    /// The summed-area-table sampler for `options`: one table per store
+    /// (built on first call), addressed with this call's wrap modes and
+    /// border colour (the table itself does not depend on them).
     fn sat(&self, options: &SamplerOptions) -> Result<Arc<SatSampler>> {
         let r = self.sat.get_or_init(|| {
             SatSampler::new(&self.base, options.wrap, options.border)
                 .map(Arc::new)
                 .map_err(|e| e.to_string())
         });
-        r.clone().map_err(crate::Error::InvalidOption)
+        let table = r.clone().map_err(crate::Error::InvalidOption)?;
+        Ok(Arc::new(
+            table.with_addressing(options.wrap, options.border),
+        ))
     }
 
     /// Whether a filter with `options` reads levels above 0.

@@ -14,6 +14,7 @@ use crate::error::Result;
 use crate::sample::TexelSink;
 use crate::texture::{Texture, expand_to_rgba};
 use crate::wrap::Wrap;
+use std::sync::Arc;
 
 /// Half-extents (in texels) beyond this are clamped: under repeat the box
 /// already averages ~2⁵²/size whole periods, so the result is the level
@@ -23,7 +24,7 @@ pub const EXTENT_LIMIT: f64 = (1u64 << 51) as f64;
 /// Box filtering with a summed-area table of level 0.
 #[derive(Clone, Debug)]
 pub struct SatSampler {
-    table: AnySat,
+    table: Arc<AnySat>,
     wrap: Wrap,
     border: [f32; 4],
     channels: usize,
@@ -63,7 +64,7 @@ impl SatSampler {
     pub fn from_table(table: AnySat, wrap: Wrap, border: [f32; 4]) -> Self {
         let channels = table.channels();
         SatSampler {
-            table,
+            table: Arc::new(table),
             wrap,
             border,
             channels,
@@ -73,6 +74,18 @@ impl SatSampler {
     /// The table.
     pub fn table(&self) -> &AnySat {
         &self.table
+    }
+
+    /// The same table with other addressing: the table holds sums of the
+    /// texels alone, so samplers with any wrap modes and border colours
+    /// share it (the wrap acts when a rectangle is read).
+    pub fn with_addressing(&self, wrap: Wrap, border: [f32; 4]) -> Self {
+        SatSampler {
+            table: Arc::clone(&self.table),
+            wrap,
+            border,
+            channels: self.channels,
+        }
     }
 
     /// The wrap modes.

@@ -2,8 +2,6 @@
 //! finding (an issue's defect or a fuzzer's crash), each with the file or
 //! input that showed it, made in the test.
 
-mod util;
-
 mod alpha_coverage_bound_broken_by_8bit_rounding;
 mod batch_ergonomics;
 mod bc_quality_steps_identical;
@@ -43,6 +41,8 @@ mod rounding_up_writes_invalid_ktx2;
 mod sample_ignores_recorded_wrap_modes;
 mod sat_rect_end_just_below_zero_read_a_texel_off;
 mod subcommand_long_help_hidden;
+mod texture_store_sat_kept_first_callers_wrap;
 mod tiff_associated_alpha_premultiplied_twice;
 mod tiff_rgb_data_sample_dropped;
 mod tiff_untagged_and_looping_refused;
+mod util;
