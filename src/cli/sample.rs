@@ -18,7 +18,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
 use parvo::Wrap;
-use parvo::sample::{Filter, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
+use parvo::sample::{CompareOp, Filter, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
 
 /// Queries parsed and sampled per batch.
 const CHUNK: usize = 1 << 16;
@@ -30,7 +30,11 @@ const CHUNK: usize = 1 << 16;
     long_about = "Sample a texture at queries read from stdin, one per line: \
                   `u v dudx dvdx dudy dvdy` (whitespace or comma separated, `#` comments, \
                   nan/inf accepted). Writes one line per query with one float per texture \
-                  channel, in linear light. --filter picks a preset; the other flags override it."
+                  channel, in linear light. --filter picks a preset; the other flags override it. \
+                  The shading languages' other calls: --level L (textureLod), --bias B \
+                  (texture with a bias), --gather C (textureGather: four values per line) and \
+                  --compare OP (a shadow sampler: a 7th column holds the reference depth, one \
+                  value per line)."
 )]
 pub struct SampleArgs {
     /// Texture: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE], or a file `parvo mip` reads.
@@ -79,6 +83,62 @@ pub struct SampleArgs {
     /// Grid size n of the supersample filter (n×n lookups, 1 to 64; default 8).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=64))]
     supersample: Option<u32>,
+    /// Sample every query on this explicit level (textureLod); derivatives are ignored.
+    #[arg(
+        long,
+        value_name = "L",
+        allow_negative_numbers = true,
+        long_help = "Sample every query on this explicit level, as GLSL textureLod / WGSL         textureSampleLevel do: the derivative columns are read but ignored, the sampler's         --lod-bias and --lod-min/--lod-max apply, and the --mag/--min/--mip filters choose the         texels (no anisotropy). With --compare, the comparison is made on that level."
+    )]
+    level: Option<f32>,
+    /// Shader LOD bias added to --lod-bias for every query (texture(s, p, bias)).
+    #[arg(
+        long,
+        value_name = "B",
+        allow_negative_numbers = true,
+        conflicts_with = "level",
+        long_help = "A shader LOD bias, as GLSL texture(s, p, bias) / WGSL textureSampleBias take         it: added to the sampler's --lod-bias for every query (λ = log2(ρ) + lod-bias + bias, then         the clamps)."
+    )]
+    bias: Option<f32>,
+    /// Print component C (0-3) of the 4 texels of the bilinear footprint (textureGather).
+    #[arg(
+        long,
+        value_name = "C",
+        value_parser = clap::value_parser!(u8).range(0..=3),
+        conflicts_with_all = ["compare", "level", "bias"],
+        long_help = "Print, per query, component C (0-3) of the four texels a bilinear lookup of         level 0 reads, in GL's textureGather order: (i0,j1) (i1,j1) (i1,j0) (i0,j0), j growing         with v; wrapped as the sampler wraps, the border colour's component outside the level         under `border`. Values are decoded (sRGB to linear). Derivatives are ignored."
+    )]
+    gather: Option<u8>,
+    /// Depth comparison: a 7th column per query is the reference; prints the filtered result.
+    #[arg(
+        long,
+        value_name = "OP",
+        long_help = "Depth comparison, as GLSL textureGrad on a sampler2DShadow (textureLod with         --level): each query line has a 7th column, the reference depth; channel 0 of every texel         read is compared (reference OP texel: never, less, equal, lequal, greater, notequal, gequal,         always), the 0/1 results filtered by --mag/--min/--mip isotropically, and one value printed         per query. The reference is clamped to [0, 1] for 8- and 16-bit textures, as GL clamps it         for fixed-point depth."
+    )]
+    compare: Option<CompareOp>,
+}
+
+/// What `parvo sample` computes per query.
+#[derive(Clone, Copy, Debug)]
+enum Mode {
+    /// Filtered colour (with gradients, an explicit level or a bias).
+    Sample,
+    Level(f32),
+    Bias(f32),
+    Gather(usize),
+    Compare(CompareOp, Option<f32>),
+}
+
+impl SampleArgs {
+    fn mode(&self) -> Mode {
+        match (self.gather, self.compare, self.level, self.bias) {
+            (Some(c), ..) => Mode::Gather(c as usize),
+            (None, Some(op), l, _) => Mode::Compare(op, l),
+            (None, None, Some(l), _) => Mode::Level(l),
+            (None, None, None, Some(b)) => Mode::Bias(b),
+            _ => Mode::Sample,
+        }
+    }
 }
 
 fn parse_border(s: &str) -> Result<[f32; 4], String> {
@@ -152,7 +212,13 @@ pub fn run(args: SampleArgs) -> Result<ExitCode> {
     drop(chain);
     let stdin = io::stdin().lock();
     let stdout = io::stdout().lock();
-    match stream(&sampler, stdin, BufWriter::with_capacity(1 << 16, stdout)) {
+    let mode = args.mode();
+    match stream(
+        &sampler,
+        mode,
+        stdin,
+        BufWriter::with_capacity(1 << 16, stdout),
+    ) {
         Err(e) if is_broken_pipe(&e) => Ok(ExitCode::SUCCESS),
         Err(e) => Err(e),
         Ok(()) => Ok(ExitCode::SUCCESS),
@@ -164,16 +230,28 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
         .is_some_and(|e| e.kind() == io::ErrorKind::BrokenPipe)
 }
 
-/// Read queries from `input`, write colours to `out`, chunk by chunk.
-fn stream(sampler: &Sampler, mut input: impl BufRead, mut out: impl Write) -> Result<()> {
+/// Read queries from `input`, write results to `out`, chunk by chunk.
+fn stream(
+    sampler: &Sampler,
+    mode: Mode,
+    mut input: impl BufRead,
+    mut out: impl Write,
+) -> Result<()> {
     let channels = sampler.chain().format().channels as usize;
+    let columns = if matches!(mode, Mode::Compare(..)) {
+        7
+    } else {
+        6
+    };
     let mut line = Vec::new();
     let mut line_no = 0usize;
     let mut queries = Vec::with_capacity(CHUNK);
+    let mut refs = Vec::with_capacity(CHUNK);
     let mut colours = Vec::with_capacity(CHUNK);
     let mut text = String::new();
     loop {
         queries.clear();
+        refs.clear();
         let mut failure = None;
         let mut eof = false;
         while queries.len() < CHUNK {
@@ -187,8 +265,11 @@ fn stream(sampler: &Sampler, mut input: impl BufRead, mut out: impl Write) -> Re
                 break;
             }
             line_no += 1;
-            match parse_line(&line) {
-                Ok(Some(q)) => queries.push(q),
+            match parse_line(&line, columns) {
+                Ok(Some((q, r))) => {
+                    queries.push(q);
+                    refs.push(r);
+                }
                 Ok(None) => {}
                 Err(e) => {
                     failure = Some(anyhow!("stdin line {line_no}: {e}"));
@@ -196,12 +277,41 @@ fn stream(sampler: &Sampler, mut input: impl BufRead, mut out: impl Write) -> Re
                 }
             }
         }
-        colours.resize(queries.len(), [0f32; 4]);
-        sampler.sample_batch(&queries, &mut colours)?;
-        for c in &colours {
-            text.clear();
-            format_colour(&mut text, c, channels);
-            out.write_all(text.as_bytes())?;
+        match mode {
+            Mode::Sample => {
+                colours.resize(queries.len(), [0f32; 4]);
+                sampler.sample_batch(&queries, &mut colours)?;
+                for c in &colours {
+                    text.clear();
+                    format_colour(&mut text, c, channels);
+                    out.write_all(text.as_bytes())?;
+                }
+            }
+            _ => {
+                for (q, r) in queries.iter().zip(&refs) {
+                    text.clear();
+                    match mode {
+                        Mode::Level(l) => {
+                            format_colour(&mut text, &sampler.sample_level(q.u, q.v, l), channels)
+                        }
+                        Mode::Bias(b) => {
+                            format_colour(&mut text, &sampler.sample_bias(q, b), channels)
+                        }
+                        Mode::Gather(c) => {
+                            format_colour(&mut text, &sampler.gather(q.u, q.v, c), 4)
+                        }
+                        Mode::Compare(op, level) => {
+                            let x = match level {
+                                Some(l) => sampler.sample_compare_level(q.u, q.v, l, *r, op),
+                                None => sampler.sample_compare(q, *r, op),
+                            };
+                            format_colour(&mut text, &[x; 4], 1)
+                        }
+                        Mode::Sample => {}
+                    }
+                    out.write_all(text.as_bytes())?;
+                }
+            }
         }
         if let Some(e) = failure {
             out.flush()?;
@@ -232,17 +342,18 @@ fn format_colour(s: &mut String, c: &[f32; 4], channels: usize) {
     s.push('\n');
 }
 
-/// Parse one input line: `Ok(None)` for blank and comment-only lines.
-fn parse_line(raw: &[u8]) -> Result<Option<Query>, String> {
+/// Parse one input line of `columns` numbers (6, or 7 with the reference
+/// depth of `--compare`): `Ok(None)` for blank and comment-only lines.
+fn parse_line(raw: &[u8], columns: usize) -> Result<Option<(Query, f32)>, String> {
     let line = std::str::from_utf8(raw).map_err(|_| "not valid UTF-8".to_string())?;
     let body = line.split('#').next().unwrap_or("");
-    let mut v = [0f32; 6];
+    let mut v = [0f32; 7];
     let mut n = 0usize;
     for tok in body
         .split(|c: char| c.is_whitespace() || c == ',')
         .filter(|t| !t.is_empty())
     {
-        if n < 6 {
+        if n < columns {
             v[n] = tok
                 .parse::<f32>()
                 .map_err(|_| format!("`{tok}` is not a number"))?;
@@ -251,7 +362,10 @@ fn parse_line(raw: &[u8]) -> Result<Option<Query>, String> {
     }
     match n {
         0 => Ok(None),
-        6 => Ok(Some(Query::new(v[0], v[1], v[2], v[3], v[4], v[5]))),
+        _ if n == columns => Ok(Some((Query::new(v[0], v[1], v[2], v[3], v[4], v[5]), v[6]))),
+        _ if columns == 7 => Err(format!(
+            "expected 7 numbers (u v dudx dvdx dudy dvdy reference), got {n}"
+        )),
         _ => Err(format!("expected 6 numbers, got {n}")),
     }
 }
@@ -262,30 +376,38 @@ mod tests {
 
     #[test]
     fn lines_parse_with_commas_comments_and_specials() {
-        let q = parse_line(b"0.5, 0.25 1e-3,0  0 -inf # comment\n")
+        let (q, _) = parse_line(b"0.5, 0.25 1e-3,0  0 -inf # comment\n", 6)
             .unwrap()
             .unwrap();
         assert_eq!((q.u, q.v, q.dudx), (0.5, 0.25, 1e-3));
         assert_eq!(q.dvdy, f32::NEG_INFINITY);
         assert!(
-            parse_line(b"nan NaN inf Infinity 0 0")
+            parse_line(b"nan NaN inf Infinity 0 0", 6)
                 .unwrap()
                 .unwrap()
+                .0
                 .u
                 .is_nan()
         );
-        assert_eq!(parse_line(b"   # only a comment").unwrap(), None);
-        assert_eq!(parse_line(b"\n").unwrap(), None);
+        assert_eq!(parse_line(b"   # only a comment", 6).unwrap(), None);
+        assert_eq!(parse_line(b"\n", 6).unwrap(), None);
         assert_eq!(
-            parse_line(b"1 2 3 4 5").unwrap_err(),
+            parse_line(b"1 2 3 4 5", 6).unwrap_err(),
             "expected 6 numbers, got 5"
         );
         assert_eq!(
-            parse_line(b"1 2 3 4 5 6 7").unwrap_err(),
+            parse_line(b"1 2 3 4 5 6 7", 6).unwrap_err(),
             "expected 6 numbers, got 7"
         );
-        assert!(parse_line(b"1 2 x 4 5 6").unwrap_err().contains("`x`"));
-        assert!(parse_line(b"1 2 3 4 5 \xff").is_err());
+        assert!(parse_line(b"1 2 x 4 5 6", 6).unwrap_err().contains("`x`"));
+        assert!(parse_line(b"1 2 3 4 5 \xff", 6).is_err());
+        let (q, r) = parse_line(b"1 2 3 4 5 6 0.25", 7).unwrap().unwrap();
+        assert_eq!((q.dvdy, r), (6.0, 0.25));
+        assert!(
+            parse_line(b"1 2 3 4 5 6", 7)
+                .unwrap_err()
+                .contains("reference")
+        );
     }
 
     #[test]

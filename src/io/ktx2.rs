@@ -36,7 +36,10 @@
 //! Reading uses the `ktx2` crate, which validates the structure. Two
 //! channels are R, G data unless the `KTXswizzle` key is `rrrg` (the
 //! specification's luminance + alpha); other swizzles are reported, not
-//! applied. Formats parvo does not read are named by their Vulkan names,
+//! applied. A `KTXorientation` other than `rd` (rows stored bottom to
+//! top for `u`, columns right to left for `l`) is applied to every level
+//! on load, with a note, so the levels come out in the order parvo writes
+//! (`rd`). Formats parvo does not read are named by their Vulkan names,
 //! and Basis Universal files (BasisLZ/ETC1S, UASTC) as such.
 
 use std::path::Path;
@@ -777,8 +780,53 @@ fn parse_error(e: ::ktx2::ParseError) -> Error {
     })
 }
 
+/// What a `KTXorientation` value asks of a texture (`two_d`: the file has
+/// a height): the EXIF orientation code that puts its rows top to bottom
+/// and its columns left to right (1 none, 2 mirror, 3 both, 4 flip), and
+/// the sentence that says so or that the value is not understood. The
+/// value is `r` or `l` (the direction of increasing x) followed, in 2-D,
+/// by `d` or `u` (of increasing y); a third letter is a volume's and
+/// irrelevant here.
+fn orientation(value: &str, two_d: bool) -> (u16, Option<String>) {
+    let mut c = value.chars();
+    let x = c.next();
+    let y = if two_d { c.next() } else { Some('d') };
+    let (left, up) = match (x, y) {
+        (Some('r'), Some('d')) => return (1, None),
+        (Some(x @ ('r' | 'l')), Some(y @ ('d' | 'u'))) => (x == 'l', y == 'u'),
+        _ => {
+            return (
+                1,
+                Some(format!(
+                    "KTXorientation `{value}` not understood (expected r or l, then d or u): the \
+                     levels are read as stored, top row first"
+                )),
+            );
+        }
+    };
+    let what = match (left, up) {
+        (true, true) => "rows stored bottom to top and columns right to left",
+        (true, false) => "columns stored right to left",
+        _ => "rows stored bottom to top",
+    };
+    let code = match (left, up) {
+        (true, true) => 3,
+        (true, false) => 2,
+        _ => 4,
+    };
+    (
+        code,
+        Some(format!(
+            "KTXorientation `{value}` ({what}): every level turned to rows top to bottom, \
+             columns left to right"
+        )),
+    )
+}
+
 /// Load a KTX2 file: every mip level of a 2-D texture (uncompressed, or
-/// BC1–BC7, optionally zstd/zlib supercompressed).
+/// BC1–BC7, optionally zstd/zlib supercompressed), its rows and columns
+/// put in parvo's order (top to bottom, left to right) as its
+/// `KTXorientation` says.
 pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     let bytes = read_bytes(path, limits)?;
     load_bytes(&bytes, limits)
@@ -924,6 +972,19 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
     }
     if levels.is_empty() {
         return Err(decode_err("no levels"));
+    }
+    if let Some((_, v)) = r.key_value_data().find(|(k, _)| *k == "KTXorientation") {
+        let text = String::from_utf8_lossy(v)
+            .trim_end_matches('\0')
+            .to_string();
+        let (code, note) = orientation(&text, h.pixel_height > 0);
+        if code != 1 {
+            levels = levels
+                .iter()
+                .map(|l| super::orient(l, code))
+                .collect::<Result<_>>()?;
+        }
+        notes.extend(note);
     }
     let mut attributes: Vec<(String, String)> = r
         .key_value_data()

@@ -596,6 +596,127 @@ fn png_transfer(path: &Path, limits: &Limits) -> Result<(ColorSpace, Option<Stri
     Ok((ColorSpace::Srgb, None, false))
 }
 
+/// What a PNG's chunks before the image data say that the `image` decoder
+/// does not apply (see [`png_extras`]).
+#[derive(Debug, Default)]
+struct PngExtras {
+    /// For 1-, 2- and 4-bit grey whose `tRNS` grey lies beyond the bit
+    /// depth: the expanded 8-bit grey that is transparent. libpng (so
+    /// OpenImageIO) keeps the sample's low bits, as the PNG specification
+    /// says a sample is stored; the `png` decoder compares the whole low
+    /// byte and so makes nothing transparent.
+    grey_trns: Option<u8>,
+    /// The orientation tag of the `eXIf` chunk, if it has one.
+    exif_orientation: Option<u16>,
+    /// The orientation tag of the EXIF block ImageMagick stores as hex in
+    /// a `Raw profile type exif` text chunk, if it has one.
+    text_orientation: Option<u16>,
+    /// What was not understood, one sentence each.
+    notes: Vec<String>,
+}
+
+/// The text of ImageMagick's raw profile form (`\nexif\n<length>\n<hex>`):
+/// the EXIF block as bytes from its TIFF header on, when the text is one.
+/// As OpenImageIO and Pillow read it: hex digits after the length, other
+/// characters skipped; the block's `Exif\0\0` prefix dropped (Pillow also
+/// takes a block that starts with the TIFF header).
+fn raw_profile_exif(text: &str) -> Option<Vec<u8>> {
+    let rest = text.trim_start().strip_prefix("exif")?.trim_start();
+    let end = rest
+        .find(|c: char| !c.is_ascii_digit())
+        .unwrap_or(rest.len());
+    let declared: usize = rest[..end].parse().ok().filter(|&n| n > 0)?;
+    let nibbles: Vec<u8> = rest[end..]
+        .chars()
+        .filter_map(|c| c.to_digit(16).map(|d| d as u8))
+        .collect();
+    let mut bytes: Vec<u8> = nibbles.chunks_exact(2).map(|p| p[0] << 4 | p[1]).collect();
+    bytes.truncate(declared);
+    if bytes.len() >= 6 && bytes[..4].eq_ignore_ascii_case(b"Exif") {
+        Some(bytes.split_off(6))
+    } else if bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*") {
+        Some(bytes)
+    } else {
+        None
+    }
+}
+
+/// Read the chunks before a PNG's image data for what [`PngExtras`]
+/// holds. A file whose header does not read gives nothing (the decoder
+/// reports it).
+fn png_extras(path: &Path) -> PngExtras {
+    use image::metadata::Orientation;
+    let mut out = PngExtras::default();
+    let Ok(file) = std::fs::File::open(path) else {
+        return out;
+    };
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    decoder.set_ignore_text_chunk(false);
+    let Ok(reader) = decoder.read_info() else {
+        return out;
+    };
+    let info = reader.info();
+    if info.color_type == png::ColorType::Grayscale
+        && let Some(&[low]) = info.trns.as_deref()
+    {
+        let max = match info.bit_depth {
+            png::BitDepth::One => 1u8,
+            png::BitDepth::Two => 3,
+            png::BitDepth::Four => 15,
+            _ => 255,
+        };
+        if low > max {
+            out.grey_trns = Some((low & max) * (255 / max));
+        }
+    }
+    let tag = |exif: &[u8]| Orientation::from_exif_chunk(exif).map(|o| o.to_exif() as u16);
+    out.exif_orientation = info.exif_metadata.as_deref().and_then(tag);
+    const KEY: &str = "Raw profile type exif";
+    // The text can be large (an EXIF thumbnail); a profile beyond this is
+    // not read.
+    const LIMIT: usize = 16 << 20;
+    let texts = info
+        .uncompressed_latin1_text
+        .iter()
+        .filter(|t| t.keyword.eq_ignore_ascii_case(KEY))
+        .map(|t| Some(t.text.clone()))
+        .chain(
+            info.compressed_latin1_text
+                .iter()
+                .filter(|t| t.keyword.eq_ignore_ascii_case(KEY))
+                .map(|t| {
+                    let mut t = t.clone();
+                    t.decompress_text_with_limit(LIMIT).ok()?;
+                    t.get_text().ok()
+                }),
+        )
+        .chain(
+            info.utf8_text
+                .iter()
+                .filter(|t| t.keyword.eq_ignore_ascii_case(KEY))
+                .map(|t| {
+                    let mut t = t.clone();
+                    t.decompress_text_with_limit(LIMIT).ok()?;
+                    t.get_text().ok()
+                }),
+        );
+    for text in texts {
+        match text.as_deref().map(raw_profile_exif) {
+            Some(Some(exif)) => {
+                out.text_orientation = out.text_orientation.or_else(|| tag(&exif));
+            }
+            Some(None) => out.notes.push(format!(
+                "the `{KEY}` text chunk is not an EXIF block in ImageMagick's hex form: ignored"
+            )),
+            None => out.notes.push(format!(
+                "the compressed `{KEY}` text chunk does not inflate (damaged, or beyond 16 MiB): \
+                 ignored"
+            )),
+        }
+    }
+    out
+}
+
 fn load_image(
     path: &Path,
     limits: &Limits,
@@ -635,6 +756,12 @@ fn load_image(
     } else {
         None
     };
+    let extras = if file_format == FileFormat::Png {
+        png_extras(path)
+    } else {
+        PngExtras::default()
+    };
+    notes.extend(extras.notes.iter().cloned());
     if file_format == FileFormat::Jpeg {
         // zune-jpeg decodes a file cut short without a word, as libjpeg
         // does with a warning (and OpenImageIO without one).
@@ -654,7 +781,14 @@ fn load_image(
     il.max_image_height = None;
     reader.limits(il);
     let mut decoder = reader.into_decoder().map_err(lim)?;
-    let orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
+    let mut orientation = decoder.orientation().map_err(lim)?.to_exif() as u16;
+    // A PNG's `eXIf` tag first, else ImageMagick's text form (OpenImageIO
+    // reads both, the chunk last).
+    if extras.exif_orientation.is_none()
+        && let Some(o) = extras.text_orientation
+    {
+        orientation = o;
+    }
     let (w, h) = decoder.dimensions();
     limits.check(w as u64, h as u64, decoder.total_bytes())?;
     let ct = decoder.color_type();
@@ -667,7 +801,7 @@ fn load_image(
         };
         move || f(w, h, ch, ty)
     });
-    let img = match ct {
+    let mut img = match ct {
         // 8-bit images (the common large case) are decoded into a buffer
         // whose pages another thread maps meanwhile (`mem::populate`):
         // the decoder runs on one core, and first touches of a 16384²
@@ -723,6 +857,11 @@ fn load_image(
         })
         .map_err(lim)?,
     };
+    if let (Some(t), DynamicImage::ImageLumaA8(b)) = (extras.grey_trns, &mut img) {
+        for px in b.chunks_exact_mut(2) {
+            px[1] = if px[0] == t { 0 } else { u8::MAX };
+        }
+    }
     let (w, h) = (img.width(), img.height());
     let f = |ch: u8, ty: ChannelType| {
         let cs = match (file_format, png_cs) {

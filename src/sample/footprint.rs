@@ -372,8 +372,8 @@ pub(crate) struct Lod {
     pub near_min: f64,
     pub near_max: f64,
     /// Wrap modes, for [`Lod::reduce`].
-    wrap_u: WrapMode,
-    wrap_v: WrapMode,
+    pub wrap_u: WrapMode,
+    pub wrap_v: WrapMode,
 }
 
 impl Lod {

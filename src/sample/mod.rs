@@ -83,6 +83,7 @@ pub mod ewa;
 mod ewa_simd;
 pub mod fetch;
 pub mod footprint;
+pub mod gl;
 mod query;
 #[cfg(target_arch = "x86_64")]
 mod simd;
@@ -102,6 +103,7 @@ use crate::wrap::Wrap;
 
 pub use fetch::LinearChain;
 pub use footprint::{Footprint, footprint, mip_linear, mip_nearest};
+pub use gl::{CompareOp, quad_queries};
 pub use query::Query;
 pub use trace::{NoTrace, TexelCounter, TexelRead, TexelRecorder, TexelSink};
 
@@ -715,6 +717,121 @@ impl Sampler {
         self.sample_traced(q, &mut NoTrace)
     }
 
+    /// Filtered colour at `(u, v)` on the explicit level `level` (GLSL
+    /// `textureLod`, WGSL `textureSampleLevel`): the sampler's bias and LOD
+    /// clamps apply, its mag/min/mip filters choose the texels, there is no
+    /// anisotropy (see [`gl`]).
+    pub fn sample_level(&self, u: f32, v: f32, level: f32) -> [f32; 4] {
+        let plan = gl::level_plan(&self.lod, &self.options, level);
+        self.probe_plan(&plan, u, v)
+    }
+
+    /// [`Sampler::sample`] with `bias` added to the sampler's LOD bias
+    /// (GLSL `texture(s, p, bias)`, WGSL `textureSampleBias`). Every method
+    /// takes it: the isotropic and anisotropic lookups in λ, EWA, the
+    /// summed-area table and the reference by scaling the footprint by
+    /// 2^bias, which moves their λ by `bias` too.
+    pub fn sample_bias(&self, q: &Query, bias: f32) -> [f32; 4] {
+        if bias == 0.0 {
+            return self.sample(q);
+        }
+        match self.kernel {
+            Kernel::Isotropic | Kernel::Texel => {
+                let mut o = self.options;
+                o.lod_bias += bias;
+                let mut s = self.clone();
+                s.lod = Lod::new(&o, self.lod.wf, self.lod.hf, self.chain.len());
+                s.options = o;
+                s.sample(q)
+            }
+            _ => {
+                let k = (bias as f64).exp2() as f32;
+                let scaled = Query::new(q.u, q.v, q.dudx * k, q.dvdx * k, q.dudy * k, q.dvdy * k);
+                self.sample(&scaled)
+            }
+        }
+    }
+
+    /// Component `component` (0–3; higher reads 3) of the four texels a
+    /// bilinear lookup of level 0 at `(u, v)` reads, in GL's order
+    /// (T_i0j1, T_i1j1, T_i1j0, T_i0j0) (GLSL `textureGather`, WGSL
+    /// `textureGather`; see [`gl`]).
+    pub fn gather(&self, u: f32, v: f32, component: usize) -> [f32; 4] {
+        match &self.chain.store {
+            Store::Rgba8(c) => gl::gather(c, &self.addr, u, v, component),
+            Store::F32(c) => gl::gather(c, &self.addr, u, v, component),
+        }
+    }
+
+    /// Depth comparison at `q`: channel 0 of each texel read is compared
+    /// with `reference` by `op` and the 0/1 results are filtered with the
+    /// sampler's mag/min/mip filters, isotropically (GLSL `textureGrad` on
+    /// a `sampler2DShadow`, WGSL `textureSampleCompare`; see [`gl`]).
+    pub fn sample_compare(&self, q: &Query, reference: f32, op: CompareOp) -> f32 {
+        let plan = gl::gradient_plan(&self.lod, &self.options, q, 0.0);
+        self.compare_plan(&plan, q.u, q.v, reference, op)
+    }
+
+    /// [`Sampler::sample_compare`] on an explicit level (GLSL `textureLod`
+    /// on a shadow sampler, WGSL `textureSampleCompareLevel`).
+    pub fn sample_compare_level(
+        &self,
+        u: f32,
+        v: f32,
+        level: f32,
+        reference: f32,
+        op: CompareOp,
+    ) -> f32 {
+        let plan = gl::level_plan(&self.lod, &self.options, level);
+        self.compare_plan(&plan, u, v, reference, op)
+    }
+
+    /// The decoded texel `(x, y)` of `level`, without filtering or wrapping
+    /// (GLSL `texelFetch`, WGSL `textureLoad`); `None` outside the level.
+    pub fn load(&self, x: i64, y: i64, level: u32) -> Option<[f32; 4]> {
+        let (x, y) = (u32::try_from(x).ok()?, u32::try_from(y).ok()?);
+        self.chain.texel(level as usize, x, y)
+    }
+
+    /// The four pixels of a 2×2 quad (top-left, top-right, bottom-left,
+    /// bottom-right), their derivatives taken inside the quad as a GPU
+    /// does ([`quad_queries`]).
+    pub fn sample_quad(&self, uv: &[[f32; 2]; 4]) -> [[f32; 4]; 4] {
+        let qs = quad_queries(uv);
+        let mut out = [[0.0; 4]; 4];
+        self.run(&qs, &mut out, &mut NoTrace);
+        out
+    }
+
+    fn probe_plan(&self, plan: &footprint::Plan, u: f32, v: f32) -> [f32; 4] {
+        let f = MagMin {
+            mag: self.options.mag,
+            min: self.options.min,
+        };
+        let q = Query::point(u, v);
+        let (u, v) = self.lod.reduce(&q);
+        match &self.chain.store {
+            Store::Rgba8(c) => trilinear::probe(c, f, plan, u, v, &self.addr, &mut NoTrace),
+            Store::F32(c) => trilinear::probe(c, f, plan, u, v, &self.addr, &mut NoTrace),
+        }
+    }
+
+    fn compare_plan(
+        &self,
+        plan: &footprint::Plan,
+        u: f32,
+        v: f32,
+        reference: f32,
+        op: CompareOp,
+    ) -> f32 {
+        let normalised = !self.chain.format().channel_type.is_float();
+        let (a, o) = (&self.addr, &self.options);
+        match &self.chain.store {
+            Store::Rgba8(c) => gl::compare(c, a, o, plan, u, v, reference, op, normalised),
+            Store::F32(c) => gl::compare(c, a, o, plan, u, v, reference, op, normalised),
+        }
+    }
+
     /// EWA with exactly computed weights (`exp` per texel, every fetch
     /// wrapped, `f64` sums): the reference the fast EWA of
     /// [`Sampler::sample`] is tested against (they agree within 1e-3).
@@ -863,7 +980,10 @@ impl Sampler {
                     *p = trilinear::plan::<F, MIP>(lod, o, q);
                 }
                 for ((p, q), o) in plans.iter().zip(qs).zip(os.iter_mut()) {
-                    *o = trilinear::probe(c, f, p, q.u as f64, q.v as f64, a, sink);
+                    // Into the first wrap period, so that a rasterizer's
+                    // tiled UVs (−30…30) take the inside-the-level path.
+                    let (u, v) = lod.reduce(q);
+                    *o = trilinear::probe(c, f, p, u, v, a, sink);
                 }
             }
         }

@@ -897,7 +897,11 @@ pub(crate) unsafe fn isotropic<P: Pixel, const MIP: u8>(
         for (b, (q8, ok)) in qc.as_chunks::<8>().0.iter().zip(&mut ok).enumerate() {
             let f = fields(q8);
             let (hi, lo, delta, lanes) = plans::<MIP>(lod, opts, &f);
-            planned.store(8 * b, f[0], f[1], hi, lo, delta);
+            let (u, v) = (
+                reduce_lanes(f[0], lod.wrap_u),
+                reduce_lanes(f[1], lod.wrap_v),
+            );
+            planned.store(8 * b, u, v, hi, lo, delta);
             *ok = lanes;
         }
         for (b, (s, ok)) in staged[..nb].iter_mut().zip(&ok).enumerate() {
@@ -936,7 +940,29 @@ fn portable<P: Pixel, const MIP: u8>(
     q: &Query,
 ) -> [f32; 4] {
     let p = trilinear::plan::<Lin, MIP>(lod, o, q);
-    trilinear::probe(c, Lin, &p, q.u as f64, q.v as f64, a, &mut NoTrace)
+    let (u, v) = lod.reduce(q);
+    trilinear::probe(c, Lin, &p, u, v, a, &mut NoTrace)
+}
+
+/// [`Lod::reduce`] on 8 lanes: `x − floor(x)` (repeat) or
+/// `x − 2·floor(x/2)` (mirror), the same exact `f64` operations; lanes
+/// whose coordinate is NaN or infinite come out NaN, which is never
+/// inside a level, so the portable code takes them (it reduces NaN to 0
+/// and keeps infinities).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn reduce_lanes(x: __m512d, mode: crate::wrap::WrapMode) -> __m512d {
+    use crate::wrap::WrapMode;
+    const FLOOR: i32 = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
+    match mode {
+        WrapMode::Repeat => _mm512_sub_pd(x, _mm512_roundscale_pd::<FLOOR>(x)),
+        WrapMode::MirroredRepeat => {
+            let half = _mm512_mul_pd(x, _mm512_set1_pd(0.5));
+            let k = _mm512_roundscale_pd::<FLOOR>(half);
+            _mm512_sub_pd(x, _mm512_mul_pd(_mm512_set1_pd(2.0), k))
+        }
+        _ => x,
+    }
 }
 
 /// Footprint-assembly lookups (`Lin` filters, mip mode `MIP`) of

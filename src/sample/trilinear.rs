@@ -61,11 +61,9 @@ pub(crate) fn probe<P: Pixel, S: TexelSink, F: Filters>(
 }
 
 /// The plan of an isotropic lookup of `q` (the first half of a lookup;
-/// [`probe`] at `(q.u, q.v)` is the second).
-///
-/// Coordinates are not reduced to the first wrap period: the per-level
-/// filters test whether the footprint is inside the level and wrap only
-/// when not.
+/// [`probe`] at `(q.u, q.v)` moved into the first wrap period by
+/// [`Lod::reduce`] is the second: the per-level filters then wrap only
+/// footprints that really cross an edge).
 #[inline(always)]
 pub(crate) fn plan<F: Filters, const MIP: u8>(lod: &Lod, o: &SamplerOptions, q: &Query) -> Plan {
     match MIP {
