@@ -40,9 +40,17 @@
 //! - [`cache`]: memory layouts of a chain, the texel cache simulator with
 //!   3C miss classes and its plain reference model, scene runs.
 //! - [`compress`]: GPU block formats (BC1–BC7) and their decoding.
-//! - [`io`]: file formats: loading PNG, JPEG, TIFF, HDR, OpenEXR, KTX2,
-//!   DDS and built-ins with decoder limits, and atomic saving of mip chains
-//!   as tiled mip-mapped EXR, KTX2, DDS or one PNG per level.
+//! - `io` (feature `io`): file formats: loading PNG, JPEG, TIFF, HDR,
+//!   OpenEXR, KTX2, DDS and built-ins with decoder limits, and atomic
+//!   saving of mip chains as tiled mip-mapped EXR, KTX2, DDS or one PNG per
+//!   level; `pipeline` (feature `io`): the file-to-files mip and compress
+//!   batch the command line runs.
+//!
+//! Without default features the crate is the sampling core above (every
+//! module but `io` and `pipeline`): pure Rust, no C code and no image
+//! codec. The features are `io` (files), `encode` (BC encoders) and `cli`
+//! (the command-line tool); the README's "Features" table lists what each
+//! brings.
 //!
 //! Level buffers of 4 MiB and more are advised for transparent huge pages
 //! on Linux (one page fault per 2 MiB instead of 512; see `mem.rs`).
@@ -68,10 +76,12 @@ pub mod cache;
 pub mod compress;
 mod cpu;
 pub mod error;
+#[cfg(feature = "io")]
 pub mod io;
 mod mem;
 pub mod mip;
 mod par;
+#[cfg(feature = "io")]
 pub mod pipeline;
 pub mod sample;
 pub mod sat;

@@ -54,6 +54,7 @@ fn advise_huge_pages(_ptr: *const u8, _len: usize) {}
 /// already present are left as they are, so it may run concurrently with
 /// writes to the same buffer. A kernel without the advice (before Linux
 /// 5.14) refuses it, and the pages fault on first write as before.
+#[cfg_attr(not(feature = "io"), allow(dead_code))] // the file pipeline's
 pub(crate) fn populate(ptr: *const u8, len: usize) {
     #[cfg(target_os = "linux")]
     {

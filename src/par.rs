@@ -29,6 +29,8 @@ pub fn on_pool_thread() -> bool {
 /// every `every` while it runs, then returns its result. On a rayon pool
 /// thread `work` runs in place and `poll` is not called (see the module
 /// docs). A panic in `work` is resumed on this thread.
+// The file pipeline's, when it encodes blocks.
+#[cfg_attr(not(all(feature = "io", feature = "encode")), allow(dead_code))]
 pub fn polled<T: Send>(
     work: impl FnOnce() -> T + Send,
     every: Duration,

@@ -1255,7 +1255,7 @@ fn build_roughness(
         let ch = v.format().channels;
         let enc = mip::normal::encode(&v, narrow(out, ch))?;
         normals.push(if out.channels != ch {
-            io::expand_channels(&enc, out.channels)?
+            enc.expand_channels(out.channels)?
         } else {
             enc
         });
@@ -2139,7 +2139,7 @@ fn convert_level(l: Texture, out: Format) -> Result<Texture> {
         l.convert(narrow)?
     };
     if conv.format().channels != out.channels {
-        io::expand_channels(&conv, out.channels)
+        conv.expand_channels(out.channels)
     } else {
         Ok(conv)
     }

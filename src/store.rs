@@ -72,12 +72,14 @@ impl TextureStore {
     /// one mips are built and filters sample with.
     /// Non-finite float values are refused
     /// ([`crate::io::LoadOptions::for_sampling`]).
+    #[cfg(feature = "io")]
     pub fn load(name: &str, limits: &crate::io::Limits) -> Result<Self> {
         let loaded = crate::io::load_with(name, limits, &crate::io::LoadOptions::for_sampling())?;
         Ok(Self::from_loaded(loaded))
     }
 
     /// A store of a loaded file (see [`TextureStore::load`]).
+    #[cfg(feature = "io")]
     pub fn from_loaded(loaded: crate::io::Loaded) -> Self {
         let wrap = loaded.info.wrap.unwrap_or_default();
         let mut s = Self::from_levels(

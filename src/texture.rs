@@ -8,7 +8,7 @@
 use half::f16;
 
 use crate::error::{Error, Result};
-use crate::texel::{self, ChannelType, Format, Texels};
+use crate::texel::{self, AlphaMode, ChannelType, Format, Texels};
 
 /// One image level: `width × height` texels of one [`Format`], row-major,
 /// row 0 first (at v = 0), channels interleaved.
@@ -212,6 +212,59 @@ impl Texture {
     /// The channel type.
     pub fn channel_type(&self) -> ChannelType {
         self.format.channel_type
+    }
+
+    /// Widen to `channels` (3 or 4) channels: grey is replicated into RGB,
+    /// R,G data (no alpha) gets B = 0, a missing alpha becomes opaque. Used
+    /// where a container has no format for the source layout (DDS has no
+    /// RGB8, PNG no two-channel colour, KTX2's `R8G8_SRGB` would decode
+    /// alpha as sRGB) and where a block encoder reads more channels than
+    /// the level has.
+    pub fn expand_channels(&self, channels: u8) -> Result<Texture> {
+        let f = self.format();
+        let from = f.channels;
+        if from == channels {
+            return Ok(self.clone());
+        }
+        if channels < from || !(3..=4).contains(&channels) {
+            return Err(Error::InvalidOption(format!(
+                "cannot widen {from} channels to {channels}"
+            )));
+        }
+        // Source channel feeding each destination channel; `None` = 0 for a
+        // colour channel, 1 (opaque) for the alpha at index 3.
+        let map: [Option<usize>; 4] = match (from, f.has_alpha()) {
+            (1, _) => [Some(0), Some(0), Some(0), None],
+            (2, true) => [Some(0), Some(0), Some(0), Some(1)],
+            (2, false) => [Some(0), Some(1), None, None],
+            _ => [Some(0), Some(1), Some(2), None],
+        };
+        let map = &map[..channels as usize];
+        fn widen<T: Copy>(v: &[T], from: usize, map: &[Option<usize>], zero: T, one: T) -> Vec<T> {
+            let mut out = Vec::with_capacity(v.len() / from * map.len());
+            for px in v.chunks_exact(from) {
+                out.extend(map.iter().enumerate().map(|(c, m)| match m {
+                    Some(i) => px[*i],
+                    None if c == 3 => one,
+                    None => zero,
+                }));
+            }
+            out
+        }
+        let n = from as usize;
+        let texels = match self.texels() {
+            Texels::U8(v) => Texels::U8(widen(v, n, map, 0, u8::MAX)),
+            Texels::U16(v) => Texels::U16(widen(v, n, map, 0, u16::MAX)),
+            Texels::F16(v) => Texels::F16(widen(v, n, map, f16::ZERO, f16::ONE)),
+            Texels::F32(v) => Texels::F32(widen(v, n, map, 0.0, 1.0)),
+        };
+        let mut format = f;
+        format.channels = channels;
+        if channels == 4 && !f.has_alpha() {
+            // The added channel is an opaque alpha.
+            format.alpha = AlphaMode::Straight;
+        }
+        Texture::from_texels(self.width(), self.height(), format, texels)
     }
 }
 

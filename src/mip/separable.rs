@@ -216,6 +216,7 @@ impl Reducer {
     }
 
     /// The source rows destination rows `y0..y1` read, sorted, each once.
+    #[cfg_attr(not(feature = "io"), allow(dead_code))] // the file pipeline's
     pub(crate) fn source_rows(&self, y0: usize, y1: usize) -> Vec<u32> {
         let mut rows: Vec<u32> = (y0..y1)
             .flat_map(|y| self.wy.of(y).map(|(j, _)| j))
@@ -230,6 +231,7 @@ impl Reducer {
     /// linear f32, `sw · channels` values); each source row the band reads
     /// is decoded once. The rows are the ones the whole-level reduction
     /// gives, bit for bit. Returns whether every value is finite.
+    #[cfg_attr(not(feature = "io"), allow(dead_code))] // the file pipeline's
     pub(crate) fn band(
         &self,
         y0: usize,

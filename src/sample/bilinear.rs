@@ -69,12 +69,14 @@ const MAGIC: f64 = 6_755_399_441_055_744.0;
 /// Exact for |x| < 2^51. For anything else — NaN, ±∞, huge values — the
 /// integer is some value far outside every level (below −2^50 or above
 /// 2^50 as an `i64`, so huge as a `u64`), which sends the caller to its
-/// general path; that path does the full, defined handling.
+/// general path; that path does the full, defined handling. The bit
+/// difference wraps by intent (for sums below 0 it leaves the `i64` range;
+/// a plain `-` traps in builds with overflow checks).
 #[inline(always)]
 pub(crate) fn floor_fast(x: f64) -> (f64, i64) {
     let r = (x + MAGIC) - MAGIC;
     let r = r - if r > x { 1.0 } else { 0.0 };
-    let i = (r + MAGIC).to_bits() as i64 - MAGIC.to_bits() as i64;
+    let i = ((r + MAGIC).to_bits() as i64).wrapping_sub(MAGIC.to_bits() as i64);
     (r, i)
 }
 

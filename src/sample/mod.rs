@@ -763,6 +763,13 @@ impl Sampler {
     /// summed-area table and the reference by scaling the footprint by
     /// 2^bias, which moves their λ by `bias` too.
     pub fn sample_bias(&self, q: &Query, bias: f32) -> [f32; 4] {
+        // The LOD rules need a finite bias (`validate`): ±∞ saturates λ at
+        // the clamp as ±4096 does; NaN reads as 0, as a NaN coordinate does.
+        let bias = if bias.is_nan() {
+            0.0
+        } else {
+            bias.clamp(-4096.0, 4096.0)
+        };
         if bias == 0.0 {
             return self.sample(q);
         }

@@ -8,6 +8,8 @@ mod bc_quality_steps_identical;
 mod colour_assumption_silent_and_no_color_for_sampling;
 mod compress_batch_hangs;
 mod dds_headers_pillow_read_as_black;
+mod debug_build_floor_fast_overflow;
+mod debug_build_sample_bias_nan_overflow;
 mod decode_errors_in_debug_words;
 mod eight_bit_chains_drift;
 mod exif_orientation_ignored;
