@@ -35,7 +35,7 @@
 //!   bottom-left − top-left, shared by the four pixels.
 //!
 //! The bilinear taps here are the same arithmetic as the filters' own
-//! ([`super::bilinear`]): `floor(u·w − ½)` and its fraction in `f64`,
+//! (`sample/bilinear.rs`): `floor(u·w − ½)` and its fraction in `f64`,
 //! after the coordinate is moved into its first wrap period.
 
 use std::fmt;
