@@ -284,12 +284,15 @@ pub(crate) fn compare<P: Pixel>(
     };
     let filter = if plan.magnify { o.mag } else { o.min };
     let hi = one(plan.hi, filter);
-    if plan.delta > 0.0 && plan.lo != plan.hi {
+    let r = if plan.delta > 0.0 && plan.lo != plan.hi {
         let lo = one(plan.lo, o.min);
         hi * (1.0 - plan.delta) + lo * plan.delta
     } else {
         hi
-    }
+    };
+    // The weights sum to 1 only up to rounding; a shadow lookup's result
+    // is a fraction in [0, 1] (never 1.0000001).
+    r.min(1.0)
 }
 
 #[cfg(test)]
