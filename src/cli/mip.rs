@@ -412,8 +412,15 @@ pub struct MipArgs {
     #[arg(long, default_value_t = 0, value_name = "N")]
     subimage: usize,
 
-    /// Keep JPEG/TIFF pixels in stored order instead of applying the EXIF orientation.
-    #[arg(long)]
+    /// Keep JPEG/PNG/TIFF pixels in stored order instead of applying the EXIF orientation.
+    #[arg(
+        long,
+        long_help = "Keep JPEG, PNG and TIFF pixels in the order the file stores them instead of \
+        applying their EXIF orientation (PNG: an eXIf chunk or ImageMagick's 'Raw profile type \
+        exif' text), as image viewers and `oiiotool --autoorient` do by default. A KTX2 file's \
+        KTXorientation is always applied: it states how the rows are stored, not how to display \
+        them."
+    )]
     no_auto_orient: bool,
 }
 

@@ -322,8 +322,9 @@ pub struct LoadOptions {
     /// Which part of a multi-part EXR or page of a multi-page TIFF (0, the
     /// default, is the first).
     pub subimage: usize,
-    /// Rotate JPEG and TIFF images by their EXIF orientation, as image
-    /// viewers and `oiiotool --autoorient` do. Default: true.
+    /// Rotate JPEG, PNG and TIFF images by their EXIF orientation, as
+    /// image viewers and `oiiotool --autoorient` do. Default: true. (A
+    /// KTX2 file's `KTXorientation` is always applied.)
     pub auto_orient: bool,
     /// Read the colour channels as this colour space whatever the file
     /// says or does not say; `None` (the default) reads them as the file
