@@ -192,3 +192,110 @@ fn nearest_mip_level_matches_the_lambda_rule_for_random_footprints() {
     }
     assert!(checked > 3500, "{checked}");
 }
+
+/// The storage formats of the README's prepared-bytes table: every channel
+/// count of every type, 8-bit as sRGB (what images hold), the others
+/// linear, plus the sRGB 16-bit and float cases.
+fn table_formats() -> Vec<Format> {
+    let mut v = Vec::new();
+    for (ty, cs) in [
+        (ChannelType::U8, ColorSpace::Srgb),
+        (ChannelType::U16, ColorSpace::Linear),
+        (ChannelType::F16, ColorSpace::Linear),
+        (ChannelType::F32, ColorSpace::Linear),
+    ] {
+        for ch in 1..=4 {
+            v.push(Format::new(ch, ty, cs));
+        }
+    }
+    for ty in [ChannelType::U16, ChannelType::F16, ChannelType::F32] {
+        v.push(Format::new(4, ty, ColorSpace::Srgb));
+    }
+    v
+}
+
+/// A smooth 1024² texture with noise in `f`, and its full box chain.
+fn rate_chain(f: Format) -> MipChain {
+    let n = 1024u32;
+    let ch = f.channels as usize;
+    let mut r = Rng(7);
+    let mut lin = Vec::with_capacity((n * n) as usize * ch);
+    for y in 0..n {
+        for x in 0..n {
+            for c in 0..ch {
+                let s = ((x as f32 * 0.013 + c as f32).sin() * (y as f32 * 0.021).cos()) * 0.4;
+                lin.push((0.5 + s + (r.f() - 0.5) * 0.1).clamp(0.0, 1.0));
+            }
+        }
+    }
+    let t = Texture::from_linear(n, n, f, &lin).unwrap();
+    mip::build(t, &MipOptions::default()).unwrap()
+}
+
+/// The benchmark's `incache` queries at 1024²: a 200×200 block minified
+/// by 1.2 and rotated by 10°.
+fn rate_queries() -> Vec<Query> {
+    let s = 1.2 / 1024.0;
+    let (sn, cs) = 10f64.to_radians().sin_cos();
+    let mut v = Vec::new();
+    for py in 0..200 {
+        for px in 0..200 {
+            let (x, y) = (px as f64, py as f64);
+            let u = 0.3 + (x * cs - y * sn) * s;
+            let w = 0.3 + (x * sn + y * cs) * s;
+            let d = [cs * s, sn * s, -sn * s, cs * s].map(|x| x as f32);
+            v.push(Query::new(u as f32, w as f32, d[0], d[1], d[2], d[3]));
+        }
+    }
+    v
+}
+
+/// Best of five runs of `f` over `n` queries, in millions per second.
+fn mqps(n: usize, mut f: impl FnMut()) -> f64 {
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let t = std::time::Instant::now();
+        let mut reps = 0;
+        while t.elapsed().as_secs_f64() < 0.15 {
+            f();
+            reps += 1;
+        }
+        best = best.min(t.elapsed().as_secs_f64() / reps as f64);
+    }
+    n as f64 / best / 1e6
+}
+
+/// The README table: prepared bytes per storage format and the one-thread
+/// slice rate of bilinear and trilinear lookups. A measurement, run on
+/// demand: `cargo test --release --test sample_storage -- --ignored
+/// --nocapture storage_table`. It asserts what the table claims: the
+/// prepared chain is at most 1.1× the stored one.
+#[test]
+#[ignore]
+fn storage_table() {
+    use std::sync::Arc;
+    let qs = rate_queries();
+    let mut out = vec![[0f32; 4]; qs.len()];
+    println!("| format | stored bytes | prepared bytes | ratio | bilinear Mq/s | trilinear Mq/s |");
+    println!("|---|---:|---:|---:|---:|---:|");
+    for f in table_formats() {
+        let chain = rate_chain(f);
+        let stored: usize = chain.levels().iter().map(|t| t.byte_len()).sum();
+        let lin = Arc::new(parvo::sample::LinearChain::new(&chain));
+        let prepared = lin.memory_bytes();
+        let mut rates = Vec::new();
+        for o in [SamplerOptions::bilinear(), SamplerOptions::trilinear()] {
+            let s = Sampler::from_linear(lin.clone(), o).unwrap();
+            rates.push(mqps(qs.len(), || s.sample_slice(&qs, &mut out).unwrap()));
+        }
+        println!(
+            "| {} {} {}ch | {stored} | {prepared} | {:.2} | {:.1} | {:.1} |",
+            f.channel_type,
+            f.color_space,
+            f.channels,
+            prepared as f64 / stored as f64,
+            rates[0],
+            rates[1]
+        );
+    }
+}
