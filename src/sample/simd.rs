@@ -78,11 +78,12 @@ const MAX_LEVELS: usize = 16;
 
 /// True when `c` can take these paths: at most [`MAX_LEVELS`] levels, and
 /// texels that are either packed RGBA8 whose colour channels share a
-/// decode table, or RGBA `f32`.
+/// decode table, or RGBA `f32`. The other storages (1–3 channel `u8`,
+/// `u16`, `f16`, 1–3 channel `f32`) take the portable paths.
 pub(crate) fn fits<P: Pixel>(c: &Chain<P>) -> bool {
     let texels_ok = match P::packed(&c.lut) {
         Some(l) => std::mem::size_of::<P>() == 4 && l.shared,
-        None => std::mem::size_of::<P>() == 16,
+        None => P::RGBA_F32 && std::mem::size_of::<P>() == 16,
     };
     c.levels.len() <= MAX_LEVELS && texels_ok
 }
