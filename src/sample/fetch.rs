@@ -48,9 +48,11 @@
 //! chain decoded to 16-byte RGBA `f32`, every 1–3 channel 8-bit chain
 //! padded to 4 bytes): a fetch decodes, where a widened texel was one
 //! 16-byte load, but a texel is 1–16 bytes instead of 4 or 16, so a level
-//! takes up to 8× fewer cache lines. The AVX-512 paths (`simd`,
-//! `ewa_simd`) read RGBA8 and RGBA `f32` as before; the other storages
-//! take the portable paths.
+//! takes up to 8× fewer cache lines. The AVX-512 bilinear, trilinear and
+//! footprint-assembly paths (`simd`) decode RGBA8 and RGBA `f32` blocks
+//! in registers as before, and the other storages' blocks with
+//! `Pixel::decode` per texel; the AVX-512 EWA sums (`ewa_simd`) read
+//! RGBA8 only, the other storages take the AVX2 or portable EWA.
 //!
 //! # Addressing
 //! Filters test once per footprint whether all the texels they need lie
@@ -211,13 +213,20 @@ impl Lut16 {
         }
     }
 
-    /// The value of code `x` in stored channel `c`, `other` when the
-    /// channel is not sRGB.
+    /// The values of `codes`: `other` of each code when no channel is
+    /// sRGB (one conversion over the whole texel, which vectorises), else
+    /// the table's value for the sRGB channels.
     #[inline(always)]
-    fn get(&self, c: usize, x: u16, other: impl FnOnce(u16) -> f32) -> f32 {
+    fn decode<const N: usize>(&self, codes: [u16; N], other: impl Fn(u16) -> f32) -> [f32; N] {
         match self.table {
-            Some(t) if self.srgb[c] => t[x as usize],
-            _ => other(x),
+            None => codes.map(other),
+            Some(t) => std::array::from_fn(|c| {
+                if self.srgb[c] {
+                    t[codes[c] as usize]
+                } else {
+                    other(codes[c])
+                }
+            }),
         }
     }
 }
@@ -265,9 +274,7 @@ where
     type Lut = Lut16;
     #[inline(always)]
     fn decode(self, lut: &Lut16) -> [f32; 4] {
-        expand(std::array::from_fn::<f32, N, _>(|c| {
-            lut.get(c, self[c], |x| x as f32 * (1.0 / 65535.0))
-        }))
+        expand(lut.decode(self, |x| x as f32 * (1.0 / 65535.0)))
     }
 
     fn view(t: &Texels) -> Option<&[Self]> {
@@ -285,9 +292,7 @@ where
     type Lut = Lut16;
     #[inline(always)]
     fn decode(self, lut: &Lut16) -> [f32; 4] {
-        expand(std::array::from_fn::<f32, N, _>(|c| {
-            lut.get(c, self[c].to_bits(), f16_to_f32)
-        }))
+        expand(lut.decode(self.map(f16::to_bits), f16_to_f32))
     }
 
     fn view(t: &Texels) -> Option<&[Self]> {
