@@ -234,9 +234,10 @@ impl Lut16 {
 /// Linear value of every 16-bit sRGB code: the crate's table
 /// ([`crate::texel::decode_u16`] reads the same one).
 fn srgb_u16_table() -> &'static [f32; 65536] {
-    crate::texel::srgb::decode16()
-        .try_into()
-        .expect("the 16-bit sRGB table has 65536 entries")
+    match crate::texel::srgb::decode16().try_into() {
+        Ok(t) => t,
+        Err(_) => unreachable!("the 16-bit sRGB table has an entry per code"),
+    }
 }
 
 /// Linear value of every `f16` code as an sRGB colour channel: the crate's
@@ -605,8 +606,10 @@ fn decoded_f32(chain: &MipChain, format: &Format) -> MipChain {
         .map(|t| Texture::from_f32(t.width(), t.height(), lin, t.to_linear()))
         .collect::<crate::Result<Vec<_>>>()
         .and_then(|levels| MipChain::from_levels(levels, *chain.options()));
-    // The same sizes and values per texel as a valid chain's levels.
-    levels.expect("a decoded chain has its source's sizes")
+    match levels {
+        Ok(c) => c,
+        Err(_) => unreachable!("a valid chain's levels, decoded, form a valid chain"),
+    }
 }
 
 impl LinearChain {
@@ -632,7 +635,9 @@ impl LinearChain {
         };
         // A `MipChain`'s levels share one format and hold whole texels, so
         // every level reads as that format's texel type.
-        let store = Store::new(&storage, &format).expect("a mip chain's levels share one format");
+        let Some(store) = Store::new(&storage, &format) else {
+            unreachable!("a mip chain's levels hold whole texels of one format")
+        };
         LinearChain {
             store,
             format,
