@@ -4,9 +4,10 @@
 //! # Structure
 //! - [`SamplerOptions`] (a hashable value type with presets) and
 //!   [`Sampler`], built once from a [`MipChain`] prepared by
-//!   [`LinearChain`]: 8-bit chains stay packed RGBA8 and are decoded at
-//!   fetch through a table, the other types are decoded to RGBA `f32` up
-//!   front (see [`fetch`] for why and for the memory cost).
+//!   [`LinearChain`]: texels stay as the chain stores them (1–4 channels
+//!   of `u8`, `u16`, `f16` or `f32`) and are decoded at fetch, and a
+//!   chain behind an `Arc` is read without a copy (see [`fetch`] for the
+//!   decode rules and the memory cost).
 //! - [`footprint`](mod@footprint): ρ, η, λ and the mip-level rules, exactly as SPEC.md
 //!   (after Vulkan and EXT_texture_filter_anisotropic) states them, plus
 //!   the per-sampler `Lod` that restates the nearest-mip rule without a
@@ -109,7 +110,7 @@ pub use query::Query;
 pub use trace::{NoTrace, TexelCounter, TexelRead, TexelRecorder, TexelSink};
 
 use bilinear::{Filters, Lin, MagMin, Near};
-use fetch::{Addressing, Chain, Pixel, Store};
+use fetch::{Addressing, Chain, Pixel, with_chain};
 use footprint::Lod;
 
 /// Filter names used on the command line and in reports (SPEC.md "Names
@@ -550,9 +551,10 @@ enum Kernel {
 
 /// A texture ready to be sampled with one set of options.
 ///
-/// Building it prepares the chain once ([`LinearChain`]: packed RGBA8 for
-/// 8-bit textures, linear RGBA `f32` otherwise); [`Sampler::from_linear`]
-/// shares a prepared chain between samplers. Lookups take `&self` and are
+/// Building it prepares the chain once ([`LinearChain`]: the texels as
+/// stored, decoded at fetch); [`Sampler::shared`] reads an `Arc`'d chain
+/// without copying it, and [`Sampler::from_linear`] shares a prepared
+/// chain between samplers (the `sat` filter's too). Lookups take `&self` and are
 /// safe to run from many threads.
 ///
 /// Every lookup goes through one dispatch on the storage, the filter and
@@ -576,30 +578,23 @@ pub struct Sampler {
 }
 
 impl Sampler {
-    /// Prepare `chain` and check `options` (an [`Error::InvalidOption`]
-    /// for out-of-range values and for the `sat` filter, which needs a
-    /// summed-area table).
+    /// Prepare a copy of `chain` ([`LinearChain::new`]) and check
+    /// `options` (an [`Error::InvalidOption`] for out-of-range values).
+    /// [`Sampler::shared`] reads the caller's chain without the copy.
     ///
     /// For `sat` the summed-area table of level 0 is built here (the
     /// narrowest exact accumulator, see [`crate::sat::choose`]).
     pub fn new(chain: &MipChain, options: SamplerOptions) -> Result<Self> {
         options.validate()?;
-        let sat = match options.method {
-            Method::Sat => {
-                let base = chain
-                    .level(0)
-                    .ok_or_else(|| Error::InvalidOption("empty mip chain".into()))?;
-                Some(Arc::new(SatSampler::new(
-                    base,
-                    options.wrap,
-                    options.border,
-                )?))
-            }
-            _ => None,
-        };
-        let mut s = Self::build(Arc::new(LinearChain::new(chain)), options, sat.is_some())?;
-        s.sat = sat;
-        Ok(s)
+        Self::from_linear(Arc::new(LinearChain::new(chain)), options)
+    }
+
+    /// A sampler that reads `chain`'s texel buffers where they are
+    /// ([`LinearChain::shared`]): no copy of the texels, whatever the
+    /// storage type (sRGB `f32` chains excepted, see [`fetch`]).
+    pub fn shared(chain: Arc<MipChain>, options: SamplerOptions) -> Result<Self> {
+        options.validate()?;
+        Self::from_linear(Arc::new(LinearChain::shared(chain)), options)
     }
 
     /// A `sat` sampler over `chain` with an already built table (the
@@ -609,12 +604,7 @@ impl Sampler {
         options: SamplerOptions,
         sat: Arc<SatSampler>,
     ) -> Result<Self> {
-        if options.method != Method::Sat {
-            return Self::new(chain, options);
-        }
-        let mut s = Self::build(Arc::new(LinearChain::new(chain)), options, true)?;
-        s.sat = Some(sat);
-        Ok(s)
+        Self::from_linear_with_sat(Arc::new(LinearChain::new(chain)), options, sat)
     }
 
     /// The summed-area-table sampler of the `sat` filter.
@@ -622,11 +612,39 @@ impl Sampler {
         self.sat.as_deref()
     }
 
-    /// A sampler over an already prepared chain.
-    /// The `sat` filter needs the stored level 0 and is refused here: use
-    /// [`Sampler::new`].
+    /// A sampler over an already prepared chain, shared with the other
+    /// samplers built from it. For the `sat` filter the summed-area table
+    /// is built here from the chain's source level 0
+    /// ([`LinearChain::source`]); [`Sampler::from_linear_with_sat`] shares
+    /// a built one.
     pub fn from_linear(chain: Arc<LinearChain>, options: SamplerOptions) -> Result<Self> {
-        Self::build(chain, options, false)
+        if options.method != Method::Sat {
+            return Self::build(chain, options, false);
+        }
+        options.validate()?;
+        let base = chain
+            .source()
+            .level(0)
+            .ok_or_else(|| Error::InvalidOption("empty mip chain".into()))?;
+        let sat = Arc::new(SatSampler::new(base, options.wrap, options.border)?);
+        Self::from_linear_with_sat(chain, options, sat)
+    }
+
+    /// A sampler over an already prepared chain with an already built
+    /// summed-area table (used when `options` is the `sat` filter, ignored
+    /// otherwise): a `sat` sampler and the mip samplers of one texture
+    /// then share one prepared chain and one table.
+    pub fn from_linear_with_sat(
+        chain: Arc<LinearChain>,
+        options: SamplerOptions,
+        sat: Arc<SatSampler>,
+    ) -> Result<Self> {
+        if options.method != Method::Sat {
+            return Self::build(chain, options, false);
+        }
+        let mut s = Self::build(chain, options, true)?;
+        s.sat = Some(sat);
+        Ok(s)
     }
 
     fn build(chain: Arc<LinearChain>, options: SamplerOptions, have_sat: bool) -> Result<Self> {
@@ -793,10 +811,7 @@ impl Sampler {
     /// (T_i0j1, T_i1j1, T_i1j0, T_i0j0) (GLSL `textureGather`, WGSL
     /// `textureGather`; see [`gl`]).
     pub fn gather(&self, u: f32, v: f32, component: usize) -> [f32; 4] {
-        match &self.chain.store {
-            Store::Rgba8(c) => gl::gather(c, &self.addr, u, v, component),
-            Store::F32(c) => gl::gather(c, &self.addr, u, v, component),
-        }
+        with_chain!(&self.chain.store, c => gl::gather(c, &self.addr, u, v, component))
     }
 
     /// Depth comparison at `q`: channel 0 of each texel read is compared
@@ -850,10 +865,7 @@ impl Sampler {
         };
         let q = Query::point(u, v);
         let (u, v) = self.lod.reduce(&q);
-        match &self.chain.store {
-            Store::Rgba8(c) => trilinear::probe(c, f, plan, u, v, &self.addr, &mut NoTrace),
-            Store::F32(c) => trilinear::probe(c, f, plan, u, v, &self.addr, &mut NoTrace),
-        }
+        with_chain!(&self.chain.store, c => trilinear::probe(c, f, plan, u, v, &self.addr, &mut NoTrace))
     }
 
     fn compare_plan(
@@ -866,10 +878,7 @@ impl Sampler {
     ) -> f32 {
         let normalised = !self.chain.format().channel_type.is_float();
         let (a, o) = (&self.addr, &self.options);
-        match &self.chain.store {
-            Store::Rgba8(c) => gl::compare(c, a, o, plan, u, v, reference, op, normalised),
-            Store::F32(c) => gl::compare(c, a, o, plan, u, v, reference, op, normalised),
-        }
+        with_chain!(&self.chain.store, c => gl::compare(c, a, o, plan, u, v, reference, op, normalised))
     }
 
     /// EWA with exactly computed weights (`exp` per texel, every fetch
@@ -878,10 +887,7 @@ impl Sampler {
     /// Uses this sampler's options as the `ewa` preset would.
     pub fn sample_ewa_exact(&self, q: &Query) -> [f32; 4] {
         let (a, lod, o) = (&self.addr, &self.lod, &self.options);
-        match &self.chain.store {
-            Store::Rgba8(c) => ewa::ewa_exact(c, a, lod, o, q, &mut NoTrace),
-            Store::F32(c) => ewa::ewa_exact(c, a, lod, o, q, &mut NoTrace),
-        }
+        with_chain!(&self.chain.store, c => ewa::ewa_exact(c, a, lod, o, q, &mut NoTrace))
     }
 
     /// [`Sampler::sample`], reporting every texel read to `sink`.
@@ -895,10 +901,7 @@ impl Sampler {
     /// Sample `queries` into `out` (same length) in order, reporting to
     /// `sink`: the one dispatch point of every lookup.
     pub(crate) fn run<S: TexelSink>(&self, queries: &[Query], out: &mut [[f32; 4]], sink: &mut S) {
-        match &self.chain.store {
-            Store::Rgba8(c) => self.run_on(c, queries, out, sink),
-            Store::F32(c) => self.run_on(c, queries, out, sink),
-        }
+        with_chain!(&self.chain.store, c => self.run_on(c, queries, out, sink))
     }
 
     fn run_on<P: Pixel, S: TexelSink>(
@@ -1033,10 +1036,7 @@ impl Sampler {
 /// The AVX-512 level table of `chain`, if that path can run on it.
 #[cfg(target_arch = "x86_64")]
 fn simd_table(chain: &LinearChain) -> Option<simd::LevelTable> {
-    match &chain.store {
-        Store::Rgba8(c) => simd::LevelTable::new(c),
-        Store::F32(c) => simd::LevelTable::new(c),
-    }
+    with_chain!(&chain.store, c => simd::LevelTable::new(c))
 }
 
 /// Queries per block of the two-pass loop (see `Sampler::run_texel`).
@@ -1052,8 +1052,6 @@ fn each(queries: &[Query], out: &mut [[f32; 4]], mut f: impl FnMut(&Query) -> [f
 
 fn sat_unavailable() -> Error {
     Error::InvalidOption(
-        "the sat filter needs the stored level 0 to build its summed-area table: \
-         use Sampler::new"
-            .into(),
+        "the sat filter needs a summed-area table, built from the chain's level 0".into(),
     )
 }

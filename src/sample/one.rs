@@ -13,7 +13,7 @@
 
 use super::aniso;
 use super::bilinear::{Filters, Lin, MagMin, Near};
-use super::fetch::{Chain, Pixel, Store};
+use super::fetch::{Chain, Pixel, with_chain};
 use super::footprint::Lod;
 #[cfg(target_arch = "x86_64")]
 use super::simd;
@@ -135,10 +135,7 @@ fn texel<F: FromOptions, const MIP: u8, const ANISO: bool>(
     o: &SamplerOptions,
     q: &Query,
 ) -> [f32; 4] {
-    match &s.chain.store {
-        Store::Rgba8(c) => texel_on::<_, F, MIP, ANISO>(s, c, lod, o, q),
-        Store::F32(c) => texel_on::<_, F, MIP, ANISO>(s, c, lod, o, q),
-    }
+    with_chain!(&s.chain.store, c => texel_on::<_, F, MIP, ANISO>(s, c, lod, o, q))
 }
 
 #[inline(always)]
@@ -182,10 +179,7 @@ fn texel_quad<F: FromOptions, const MIP: u8, const ANISO: bool>(
     s: &Sampler,
     qs: &[Query; 4],
 ) -> [[f32; 4]; 4] {
-    match &s.chain.store {
-        Store::Rgba8(c) => texel_quad_on::<_, F, MIP, ANISO>(s, c, qs),
-        Store::F32(c) => texel_quad_on::<_, F, MIP, ANISO>(s, c, qs),
-    }
+    with_chain!(&s.chain.store, c => texel_quad_on::<_, F, MIP, ANISO>(s, c, qs))
 }
 
 #[inline(always)]

@@ -27,7 +27,10 @@
 //!   decoded at once — `vpermi2b` looks each code up in the four byte
 //!   planes of the decode table and unpacking interleaves the planes back
 //!   into `f32`s; linear channels are converted and scaled instead. An
-//!   `f32` block is two 32-byte loads per lane. The bilinear blend and the
+//!   `f32` block is two 32-byte loads per lane. Blocks of the other
+//!   storages (1–3 channel `u8`, `u16`, `f16`, 1–3 channel `f32`) are
+//!   decoded texel by texel with `Pixel::decode` and then blended in
+//!   registers like the others. The bilinear blend and the
 //!   level blend then run on 4 lanes per instruction and store 4 results
 //!   at once. Footprint assembly then sums each query's probes in order.
 //!
@@ -77,12 +80,15 @@ pub(crate) fn available() -> bool {
 const MAX_LEVELS: usize = 16;
 
 /// True when `c` can take these paths: at most [`MAX_LEVELS`] levels, and
-/// texels that are either packed RGBA8 whose colour channels share a
-/// decode table, or RGBA `f32`.
+/// texels of at most 16 bytes; packed RGBA8 ones need colour channels
+/// that share a decode table. RGBA8 and RGBA `f32` blocks are decoded in
+/// registers; the other storages (1–3 channel `u8`, `u16`, `f16`, 1–3
+/// channel `f32`) by `Pixel::decode` per texel ([`group_any`]), the rest
+/// of the lookup in registers as for the others.
 pub(crate) fn fits<P: Pixel>(c: &Chain<P>) -> bool {
     let texels_ok = match P::packed(&c.lut) {
         Some(l) => std::mem::size_of::<P>() == 4 && l.shared,
-        None => std::mem::size_of::<P>() == 16,
+        None => std::mem::size_of::<P>() <= 16,
     };
     c.levels.len() <= MAX_LEVELS && texels_ok
 }
@@ -201,13 +207,21 @@ fn blocks<P: Pixel>(ls: &Levels, lvl: __m512i, u: __m512d, v: __m512d) -> Blocks
         & _mm512_cmplt_epu64_mask(j0, _mm512_sub_epi64(h, one));
     // Lanes inside the level have 0 ≤ i0, j0 and w below 2^32, so a
     // 32 × 32 → 64-bit multiply gives j0·w (other lanes' addresses are
-    // replaced before use). The texel size is a power of two: a shift.
+    // replaced before use). Bytes from texels: a shift for the sizes that
+    // are powers of two, a multiply for 3, 6 and 12.
     let k = _mm512_add_epi64(_mm512_mul_epu32(j0, w), i0);
-    let shift = _mm512_set1_epi64(std::mem::size_of::<P>().trailing_zeros() as i64);
-    let top = _mm512_add_epi64(look_epi64(&ls.base, lvl), _mm512_sllv_epi64(k, shift));
+    let size = std::mem::size_of::<P>();
+    let bytes = |n: __m512i| {
+        if size.is_power_of_two() {
+            _mm512_sllv_epi64(n, _mm512_set1_epi64(size.trailing_zeros() as i64))
+        } else {
+            _mm512_mul_epu32(n, _mm512_set1_epi64(size as i64))
+        }
+    };
+    let top = _mm512_add_epi64(look_epi64(&ls.base, lvl), bytes(k));
     Blocks {
         top,
-        bot: _mm512_add_epi64(top, _mm512_sllv_epi64(w, shift)),
+        bot: _mm512_add_epi64(top, bytes(w)),
         al: _mm512_cvtpd_ps(_mm512_sub_pd(x, fx)),
         be: _mm512_cvtpd_ps(_mm512_sub_pd(y, fy)),
         inside,
@@ -244,7 +258,8 @@ fn addresses(b: &Blocks, fast: u8) -> ([u64; 8], [u64; 8]) {
 /// # Safety
 /// The address is a block address of a lane inside its level, or
 /// [`ZEROS`], and `size_of::<T>()` bytes from it stay inside that
-/// allocation (at most 32: two `f32` texels, or [`ZEROS`]).
+/// allocation (at most 32: two texels of at most 16 bytes, or
+/// [`ZEROS`]).
 #[inline(always)]
 unsafe fn read<T: Copy>(addr: u64) -> T {
     // SAFETY: the caller's contract; the address came from
@@ -417,8 +432,34 @@ unsafe fn group<P: Pixel>(lut: &P::Lut, top: &[u64; 8], bot: &[u64; 8], h: usize
         // SAFETY: the caller's contract.
         Some(l) => unsafe { group_rgba8(l, t, b) },
         // SAFETY: the caller's contract.
-        None => unsafe { group_f32(t, b) },
+        None if P::RGBA_F32 => unsafe { group_f32(t, b) },
+        // SAFETY: the caller's contract.
+        None => unsafe { group_any::<P>(lut, t, b) },
     }
+}
+
+/// [`group_rgba8`] for the other storages: each lane's two texels per row
+/// read and decoded by `Pixel::decode` (the portable code's decode, so
+/// the same values), then loaded as the four corner registers.
+///
+/// # Safety
+/// The addresses satisfy [`read`] for `2 · size_of::<P>()` bytes (at most
+/// 32: [`fits`] admits texels of at most 16 bytes).
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+unsafe fn group_any<P: Pixel>(lut: &P::Lut, top: &[u64], bot: &[u64]) -> [__m512; 4] {
+    // Corner c of lane j at d[c][j].
+    let mut d = [[[0f32; 4]; 4]; 4];
+    for j in 0..4 {
+        // SAFETY: the caller's contract.
+        let (t, b) = unsafe { (read::<[P; 2]>(top[j]), read::<[P; 2]>(bot[j])) };
+        d[0][j] = t[0].decode(lut);
+        d[1][j] = t[1].decode(lut);
+        d[2][j] = b[0].decode(lut);
+        d[3][j] = b[1].decode(lut);
+    }
+    // SAFETY: unaligned 64-byte loads of the 16-float corner arrays.
+    d.map(|c| unsafe { _mm512_loadu_ps(c.as_ptr().cast()) })
 }
 
 /// Lane `4h + j` of an 8-lane vector in every float of 128-bit group `j`.

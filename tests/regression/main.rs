@@ -41,6 +41,7 @@ mod readme_said_built_fuzz_targets_were_missing;
 mod roughness_map_ringing_went_below_zero;
 mod rounding_up_writes_invalid_ktx2;
 mod sample_ignores_recorded_wrap_modes;
+mod sampler_storage_widened;
 mod sat_rect_end_just_below_zero_read_a_texel_off;
 mod subcommand_long_help_hidden;
 mod texture_store_sat_kept_first_callers_wrap;
