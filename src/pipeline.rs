@@ -59,20 +59,6 @@ pub enum AlphaChoice {
     None,
 }
 
-/// The container of a batch's outputs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Extension {
-    /// Tiled, mip-mapped OpenEXR.
-    #[default]
-    Exr,
-    /// KTX2.
-    Ktx2,
-    /// DDS.
-    Dds,
-    /// One PNG per level (`NAME_{level}.png`).
-    Png,
-}
-
 /// Everything a job needs besides its input and output.
 #[derive(Clone, Debug)]
 pub struct Settings {
@@ -263,7 +249,7 @@ impl Job {
 
     /// A batch into `dir`: each input's file stem (a `builtin:` name with
     /// `:` as `-`) with the extension's suffix.
-    pub fn batch(inputs: &[String], dir: &Path, ext: Extension) -> Vec<Job> {
+    pub fn batch(inputs: &[String], dir: &Path, kind: OutputKind) -> Vec<Job> {
         inputs
             .iter()
             .map(|input| {
@@ -275,30 +261,15 @@ impl Job {
                         .map(|s| s.to_string_lossy().into_owned())
                         .unwrap_or_else(|| "output".into())
                 };
-                let (output, kind) = match ext {
-                    Extension::Exr => (dir.join(format!("{stem}.exr")), OutputKind::Exr),
-                    Extension::Ktx2 => (dir.join(format!("{stem}.ktx2")), OutputKind::Ktx2),
-                    Extension::Dds => (dir.join(format!("{stem}.dds")), OutputKind::Dds),
-                    Extension::Png => (
-                        dir.join(format!("{stem}_{{level}}.png")),
-                        OutputKind::PngLevels,
-                    ),
-                };
                 Job {
                     input: input.clone(),
-                    output,
+                    output: kind.batch_path(dir, &stem),
                     kind,
                 }
             })
             .collect()
     }
 }
-
-/// File extensions [`expand_inputs`] takes from a directory: the
-/// containers parvo reads (case does not matter).
-pub const IMAGE_EXTENSIONS: &[&str] = &[
-    "png", "jpg", "jpeg", "tif", "tiff", "tx", "hdr", "exr", "ktx2", "dds",
-];
 
 /// The inputs of a batch with every directory replaced by the image files
 /// in it (not its subdirectories; hidden files skipped; by name, so the
@@ -323,8 +294,7 @@ pub fn expand_inputs(inputs: &[String]) -> Result<Vec<String>> {
             let p = entry.map_err(io_err)?.path();
             let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
             let image = p.extension().is_some_and(|e| {
-                IMAGE_EXTENSIONS
-                    .iter()
+                io::container::read_extensions()
                     .any(|x| e.to_string_lossy().eq_ignore_ascii_case(x))
             });
             if image && p.is_file() && !name.is_some_and(|n| n.starts_with('.')) {
@@ -334,7 +304,9 @@ pub fn expand_inputs(inputs: &[String]) -> Result<Vec<String>> {
         if found.is_empty() {
             return Err(Error::InvalidOption(format!(
                 "directory {input} holds no image parvo reads (.{})",
-                IMAGE_EXTENSIONS.join(", .")
+                io::container::read_extensions()
+                    .collect::<Vec<_>>()
+                    .join(", .")
             )));
         }
         found.sort();
@@ -392,7 +364,9 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
         if let Specular::BlinnPhong(_) = r.specular {
             let float = |kind: OutputKind| match s.out_type {
                 Some(t) => t.is_float() && kind.supports(t),
-                None => kind == OutputKind::Exr,
+                // A container whose own default is float, even for an
+                // 8-bit source.
+                None => kind.default_type(ChannelType::U8).is_float(),
             };
             let kinds: Vec<OutputKind> = match &r.output {
                 Some((_, k)) => vec![*k],
@@ -417,10 +391,7 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
         if !crate::compress::can_encode(bf) {
             return bad(format!("parvo does not encode {bf}"));
         }
-        if let Some(j) = jobs
-            .iter()
-            .find(|j| !matches!(j.kind, OutputKind::Ktx2 | OutputKind::Dds))
-        {
+        if let Some(j) = jobs.iter().find(|j| !j.kind.stores().blocks) {
             return bad(format!(
                 "--compress: {} cannot store block-compressed texels; use .ktx2 or .dds (output {})",
                 j.kind.name(),
@@ -452,7 +423,7 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
                 sc.name()
             ));
         }
-        if let Some(j) = jobs.iter().find(|j| j.kind != OutputKind::Ktx2) {
+        if let Some(j) = jobs.iter().find(|j| !j.kind.stores().supercompression) {
             return bad(format!(
                 "--{}: supercompression is a KTX2 feature; output {} is {}",
                 sc.name(),
@@ -479,16 +450,12 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
         && let Some(j) = jobs
             .iter()
             .chain(&rough_out)
-            .find(|j| matches!(j.kind, OutputKind::Ktx2 | OutputKind::Dds))
+            .find(|j| !j.kind.stores().round_up)
     {
         return bad(format!(
             "--rounding up: {} defines its level sizes as floor(size / 2^k); \
              use .exr or PNG levels for rounded-up chains (output {})",
-            if j.kind == OutputKind::Ktx2 {
-                "KTX2"
-            } else {
-                "DDS"
-            },
+            j.kind.name(),
             j.output.display()
         ));
     }
@@ -579,13 +546,7 @@ pub enum Stage {
 pub fn output_format(src: Format, kind: OutputKind, s: &Settings) -> Result<Format> {
     let ty = match s.out_type {
         Some(t) => t,
-        None => match kind {
-            OutputKind::Exr if src.channel_type == ChannelType::F32 => ChannelType::F32,
-            OutputKind::Exr => ChannelType::F16,
-            OutputKind::PngLevels if src.channel_type == ChannelType::U8 => ChannelType::U8,
-            OutputKind::PngLevels => ChannelType::U16,
-            OutputKind::Ktx2 | OutputKind::Dds => src.channel_type,
-        },
+        None => kind.default_type(src.channel_type),
     };
     if !kind.supports(ty) {
         return Err(Error::InvalidOption(format!(
@@ -603,17 +564,11 @@ pub fn output_format(src: Format, kind: OutputKind, s: &Settings) -> Result<Form
     // Each container's alpha convention: OpenEXR defines colour as
     // associated with alpha, PNG as unassociated; KTX2 and DDS say which in
     // their headers, so they keep the source's.
-    let alpha = match kind {
-        OutputKind::Exr if src.has_alpha() => AlphaMode::Premultiplied,
-        OutputKind::PngLevels if src.has_alpha() => AlphaMode::Straight,
+    let alpha = match kind.stores().alpha {
+        Some(a) if src.has_alpha() => a,
         _ => src.alpha,
     };
-    let f = Format::new(src.channels, ty, cs).with_alpha(alpha);
-    Ok(match kind {
-        OutputKind::Ktx2 => io::ktx2::storable(f),
-        OutputKind::Dds => io::dds::storable(f),
-        _ => f,
-    })
+    Ok(kind.storable(Format::new(src.channels, ty, cs).with_alpha(alpha)))
 }
 
 /// The text the fingerprint hashes beside level 0: every setting that
@@ -749,7 +704,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         nan_policy: s.nan_policy,
         fast_paths: true,
     };
-    if job.kind == OutputKind::Exr {
+    if job.kind.stores().whole_chain {
         let full = mip::level_count(base.width(), base.height(), s.rounding, None);
         if s.levels.is_some_and(|n| n < full) {
             return Err(Error::InvalidOption(format!(
@@ -832,7 +787,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     // output type: each group of its rows is built, compressed and written
     // (`io::exr::save_streamed`), so level 0's output buffer is neither
     // allocated nor faulted in.
-    let base = if job.kind == OutputKind::Exr
+    let base = if job.kind.stores().streamed_level0
         && s.compress.is_none()
         && s.roughness.is_none()
         && !s.normal_map
@@ -927,12 +882,12 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         && let Some((path, kind)) = &r.output
     {
         let rs = SaveOptions {
-            channel_names: (*kind == OutputKind::Exr).then(|| vec!["Y".to_string()]),
+            channel_names: kind.stores().channel_names.then(|| vec!["Y".to_string()]),
             ..save.clone()
         };
         io::save(&levels, s.rounding, path, *kind, &rs)?;
     }
-    if job.kind == OutputKind::PngLevels {
+    if job.kind.stores().file_per_level {
         // Levels an earlier, longer chain left behind under this template.
         let stale = io::png_levels::remove_stale(&job.output, levels.len())?;
         let list = |v: &[PathBuf]| {
@@ -1265,24 +1220,10 @@ fn build_roughness(
         Some((_, kind)) => {
             let ty = match s.out_type {
                 Some(t) if kind.supports(t) => t,
-                _ => match kind {
-                    OutputKind::Exr => ChannelType::F16,
-                    OutputKind::PngLevels if out.channel_type == ChannelType::U16 => {
-                        ChannelType::U16
-                    }
-                    OutputKind::PngLevels => ChannelType::U8,
-                    OutputKind::Ktx2 | OutputKind::Dds if kind.supports(out.channel_type) => {
-                        out.channel_type
-                    }
-                    _ => ChannelType::U8,
-                },
+                _ => kind.data_type(out.channel_type),
             };
-            let f = Format::new(1, ty, ColorSpace::Linear).with_alpha(AlphaMode::None);
-            let f = match kind {
-                OutputKind::Ktx2 => io::ktx2::storable(f),
-                OutputKind::Dds => io::dds::storable(f),
-                _ => f,
-            };
+            let f =
+                kind.storable(Format::new(1, ty, ColorSpace::Linear).with_alpha(AlphaMode::None));
             Some(
                 chain
                     .specular
@@ -1398,7 +1339,7 @@ fn prefault_streamed(
     ty: ChannelType,
 ) -> Option<Vec<Texels>> {
     // (A dry run builds nothing: no buffers to make.)
-    let fused = job.kind == OutputKind::Exr
+    let fused = job.kind.stores().streamed_level0
         && !s.dry_run
         && s.compress.is_none()
         && s.roughness.is_none()
@@ -2208,7 +2149,7 @@ mod tests {
         let ptrs: Vec<*const u8> = bufs.iter_mut().map(first_ptr).collect();
         let options = MipOptions::default();
         let src = Format::new(4, ChannelType::U8, ColorSpace::Srgb).with_alpha(AlphaMode::Straight);
-        let out = output_format(src, OutputKind::Exr, &s).unwrap();
+        let out = output_format(src, OutputKind::EXR, &s).unwrap();
         let assoc = Some(AlphaMode::Premultiplied);
         let base = rgba8(w, h).reinterpret(src).unwrap();
         let Ok(mut st) = Streamer::new(base, &options, src, out, assoc, Some(bufs)).unwrap() else {

@@ -14,14 +14,14 @@ fn files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
     let chain16 = mip::build(f16, &MipOptions::default()).unwrap();
     let mut out = Vec::new();
     for (name, kind, levels) in [
-        ("a.exr", OutputKind::Exr, chain16.levels()),
-        ("a.ktx2", OutputKind::Ktx2, chain8.levels()),
-        ("a.dds", OutputKind::Dds, chain8.levels()),
-        ("a_{level}.png", OutputKind::PngLevels, chain8.levels()),
+        ("a.exr", OutputKind::EXR, chain16.levels()),
+        ("a.ktx2", OutputKind::KTX2, chain8.levels()),
+        ("a.dds", OutputKind::DDS, chain8.levels()),
+        ("a_{level}.png", OutputKind::PNG_LEVELS, chain8.levels()),
     ] {
         let p = dir.join(name);
         io::save(levels, Rounding::Down, &p, kind, &SaveOptions::default()).unwrap();
-        out.push(if kind == OutputKind::PngLevels {
+        out.push(if kind == OutputKind::PNG_LEVELS {
             io::png_levels::level_path(&p, 0)
         } else {
             p

@@ -150,7 +150,7 @@ fn every_lossless_compression_round_trips_exactly() {
                 tile: (32, 16),
                 ..SaveOptions::default()
             };
-            io::save(chain.levels(), Rounding::Down, &p, OutputKind::Exr, &opts).unwrap();
+            io::save(chain.levels(), Rounding::Down, &p, OutputKind::EXR, &opts).unwrap();
             let back = io::load(p.to_str().unwrap(), &Limits::default()).unwrap();
             assert_eq!(back.levels, chain.levels(), "{c} {ty}");
         }

@@ -85,7 +85,7 @@ fn overlapped_loads_tell_the_header_and_load_the_same_texels() {
         .unwrap()],
         parvo::mip::Rounding::Down,
         &exr,
-        io::OutputKind::Exr,
+        io::OutputKind::EXR,
         &io::SaveOptions {
             tile: (16, 16),
             ..io::SaveOptions::default()

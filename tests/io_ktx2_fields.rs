@@ -170,7 +170,7 @@ fn premultiplied_alpha_sets_the_dfd_flag_and_reads_back() {
         &levels,
         parvo::Rounding::Down,
         &path,
-        io::OutputKind::Ktx2,
+        io::OutputKind::KTX2,
         &SaveOptions::default(),
     )
     .unwrap();

@@ -227,7 +227,7 @@ fn fused_exr_writes_equal_whole_chain_writes_for_every_tile_shape() {
                 assert!(g.texels() == e.texels(), "{case}: level {k} differs");
             }
             // The whole-chain writer, with the header the pipeline wrote.
-            let stored = io::stored_fingerprint(&out, OutputKind::Exr);
+            let stored = io::stored_fingerprint(&out, OutputKind::EXR);
             let again = dir.path().join(format!("w{w}_{}x{}.exr", tile.0, tile.1));
             let save = SaveOptions {
                 tile,
@@ -246,7 +246,7 @@ fn fused_exr_writes_equal_whole_chain_writes_for_every_tile_shape() {
                 &got,
                 mip::Rounding::default(),
                 &again,
-                OutputKind::Exr,
+                OutputKind::EXR,
                 &save,
             )
             .unwrap();
@@ -312,7 +312,7 @@ fn banded_chains_equal_whole_image_chains_for_every_filter_and_wrap_mode() {
                     std::slice::from_ref(&src),
                     parvo::mip::Rounding::Down,
                     &p,
-                    OutputKind::Exr,
+                    OutputKind::EXR,
                     &SaveOptions::default(),
                 )
                 .unwrap();

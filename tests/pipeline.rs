@@ -7,7 +7,7 @@
 use std::sync::Mutex;
 
 use parvo::io::OutputKind;
-use parvo::pipeline::{self, Extension, Job, Settings, Status};
+use parvo::pipeline::{self, Job, Settings, Status};
 use parvo::{MipFilter, Rounding};
 
 fn run(jobs: &[Job], s: &Settings) -> Vec<(String, Result<Status, String>)> {
@@ -30,9 +30,9 @@ fn a_batch_writes_then_is_up_to_date_then_rebuilds_on_a_new_setting() {
         "builtin:checker:64".to_string(),
         "builtin:zoneplate:32".to_string(),
     ];
-    let jobs = Job::batch(&inputs, dir.path(), Extension::Ktx2);
+    let jobs = Job::batch(&inputs, dir.path(), OutputKind::KTX2);
     assert_eq!(jobs[0].output, dir.path().join("builtin-checker-64.ktx2"));
-    assert!(jobs.iter().all(|j| j.kind == OutputKind::Ktx2));
+    assert!(jobs.iter().all(|j| j.kind == OutputKind::KTX2));
     let mut s = Settings {
         update: true,
         ..Default::default()

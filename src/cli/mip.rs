@@ -25,8 +25,8 @@ use parvo::io::{self, Limits, OutputKind};
 use parvo::mip::roughness::{NormalChannels, Specular};
 use parvo::mip::{MipFilter, NanPolicy, Rounding};
 use parvo::pipeline::{
-    self, AlphaChoice, ColorChoice, Extension, Job, Outcome, ResizeTo, RoughnessSettings,
-    RoughnessSource, Settings, Stage, Status,
+    self, AlphaChoice, ColorChoice, Job, Outcome, ResizeTo, RoughnessSettings, RoughnessSource,
+    Settings, Stage, Status,
 };
 use parvo::texel::ChannelType;
 
@@ -117,16 +117,13 @@ pub enum ResizeArg {
     Pow2,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ExtArg {
-    /// Tiled, mip-mapped OpenEXR.
-    Exr,
-    /// KTX 2.0.
-    Ktx2,
-    /// DDS.
-    Dds,
-    /// One PNG per level (`NAME_{level}.png`).
-    Png,
+/// The `--ext` choices: the output containers of the library's table.
+fn ext_parser() -> impl clap::builder::TypedValueParser<Value = OutputKind> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(
+        io::container::outputs().map(|k| PossibleValue::new(k.id()).help(k.summary())),
+    )
+    .map(|id| OutputKind::from_id(&id).expect("a listed container"))
 }
 
 /// Arguments of `parvo mip`.
@@ -173,8 +170,8 @@ pub struct MipArgs {
     out_dir: Option<PathBuf>,
 
     /// Output container in --out-dir mode.
-    #[arg(long, value_enum, default_value = "exr")]
-    ext: ExtArg,
+    #[arg(long, default_value = "exr", value_parser = ext_parser())]
+    ext: OutputKind,
 
     /// Downsampling filter: box, triangle, kaiser, lanczos3, mitchell.
     #[arg(long, default_value = "box", value_name = "FILTER")]
@@ -480,17 +477,6 @@ impl From<AlphaArg> for AlphaChoice {
     }
 }
 
-impl From<ExtArg> for Extension {
-    fn from(e: ExtArg) -> Self {
-        match e {
-            ExtArg::Exr => Extension::Exr,
-            ExtArg::Ktx2 => Extension::Ktx2,
-            ExtArg::Dds => Extension::Dds,
-            ExtArg::Png => Extension::Png,
-        }
-    }
-}
-
 /// The library settings of these arguments.
 fn settings(args: &MipArgs) -> Settings {
     Settings {
@@ -637,7 +623,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
                 );
                 return Ok(ExitCode::from(1));
             }
-            Job::batch(&inputs, dir, args.ext.into())
+            Job::batch(&inputs, dir, args.ext)
         }
         _ => return usage("give -o OUTPUT (one input) or --out-dir DIR (a batch)".into()),
     };
@@ -758,7 +744,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn summary_line(job: &Job, o: &Outcome, args: &MipArgs, secs: f64) -> String {
-    let out = if job.kind == OutputKind::PngLevels {
+    let out = if job.kind.stores().file_per_level {
         format!("{} (x{})", o.output.display(), o.level_sizes.len())
     } else {
         o.output.display().to_string()

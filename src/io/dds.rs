@@ -1355,6 +1355,76 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
     Ok(Loaded { levels, info })
 }
 
+/// DDS in the container table: reads legacy and DX10 headers
+/// (uncompressed and BC); writes the legacy header where a format has
+/// one, else DX10; sizes rounded down; no fingerprint.
+pub struct Dds;
+
+impl super::Container for Dds {
+    fn id(&self) -> &'static str {
+        "dds"
+    }
+    fn name(&self) -> &'static str {
+        "DDS"
+    }
+    fn tag(&self) -> &'static str {
+        "Dds"
+    }
+    fn summary(&self) -> &'static str {
+        "DDS"
+    }
+    fn detect(&self, magic: &[u8]) -> bool {
+        magic.starts_with(b"DDS ")
+    }
+    fn load(
+        &self,
+        path: &Path,
+        limits: &Limits,
+        _options: &super::LoadOptions,
+        _overlap: Option<super::Overlap<'_>>,
+    ) -> Result<Loaded> {
+        load(path, limits)
+    }
+    fn read_extensions(&self) -> &'static [&'static str] {
+        &["dds"]
+    }
+    fn stores(&self) -> Option<super::Stores> {
+        Some(super::Stores {
+            float: true,
+            integer: true,
+            blocks: true,
+            whole_chain: false,
+            round_up: false,
+            fingerprint: false,
+            supercompression: false,
+            channel_names: false,
+            file_per_level: false,
+            streamed_level0: false,
+            alpha: None,
+        })
+    }
+    fn storable(&self, f: Format) -> Format {
+        storable(f)
+    }
+    fn save(
+        &self,
+        levels: &[Texture],
+        _rounding: crate::mip::Rounding,
+        path: &Path,
+        _options: &super::SaveOptions,
+    ) -> Result<()> {
+        save(levels, path)
+    }
+    fn save_blocks(
+        &self,
+        chain: &BlockChain,
+        path: &Path,
+        _options: &super::SaveOptions,
+    ) -> Result<()> {
+        save_blocks(chain, path)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1225,3 +1225,80 @@ fn place_in_display_window(
     }
     Ok((out, note))
 }
+
+/// OpenEXR in the container table: reads scanline, tiled and mip-mapped
+/// files (a chosen part, chosen channels); writes tiled, mip-mapped
+/// files of f16 or f32, colour premultiplied by alpha as the format
+/// defines it, the whole chain, sizes rounded down or up, the
+/// fingerprint as an attribute, level 0 streamed band by band.
+pub struct OpenExr;
+
+impl super::Container for OpenExr {
+    fn id(&self) -> &'static str {
+        "exr"
+    }
+    fn name(&self) -> &'static str {
+        "OpenEXR"
+    }
+    fn tag(&self) -> &'static str {
+        "Exr"
+    }
+    fn summary(&self) -> &'static str {
+        "Tiled, mip-mapped OpenEXR"
+    }
+    fn detect(&self, magic: &[u8]) -> bool {
+        magic.starts_with(&[0x76, 0x2f, 0x31, 0x01])
+    }
+    fn load(
+        &self,
+        path: &Path,
+        limits: &Limits,
+        options: &super::LoadOptions,
+        _overlap: Option<super::Overlap<'_>>,
+    ) -> Result<Loaded> {
+        load(path, limits, options)
+    }
+    fn read_extensions(&self) -> &'static [&'static str] {
+        &["exr"]
+    }
+    fn selects_channels(&self) -> bool {
+        true
+    }
+    fn stores(&self) -> Option<super::Stores> {
+        Some(super::Stores {
+            float: true,
+            integer: false,
+            blocks: false,
+            whole_chain: true,
+            round_up: true,
+            fingerprint: true,
+            supercompression: false,
+            channel_names: true,
+            file_per_level: false,
+            streamed_level0: true,
+            alpha: Some(crate::texel::AlphaMode::Premultiplied),
+        })
+    }
+    fn default_type(&self, src: ChannelType) -> ChannelType {
+        if src == ChannelType::F32 {
+            ChannelType::F32
+        } else {
+            ChannelType::F16
+        }
+    }
+    fn data_type(&self, _main: ChannelType) -> ChannelType {
+        ChannelType::F16
+    }
+    fn save(
+        &self,
+        levels: &[Texture],
+        rounding: Rounding,
+        path: &Path,
+        options: &SaveOptions,
+    ) -> Result<()> {
+        save(levels, rounding, path, options)
+    }
+    fn stored_fingerprint(&self, path: &Path) -> Option<String> {
+        stored_fingerprint(path)
+    }
+}

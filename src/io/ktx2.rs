@@ -1038,3 +1038,71 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
     info.attributes = attributes;
     Ok(Loaded { levels, info })
 }
+
+/// KTX 2.0 in the container table: reads and writes every vkFormat parvo
+/// has a texel format for and the BC block formats, plain or
+/// supercompressed; sizes rounded down; the fingerprint as key/value data.
+pub struct Ktx2;
+
+impl super::Container for Ktx2 {
+    fn id(&self) -> &'static str {
+        "ktx2"
+    }
+    fn name(&self) -> &'static str {
+        "KTX2"
+    }
+    fn tag(&self) -> &'static str {
+        "Ktx2"
+    }
+    fn summary(&self) -> &'static str {
+        "KTX 2.0"
+    }
+    fn detect(&self, magic: &[u8]) -> bool {
+        magic.starts_with(IDENTIFIER.as_slice())
+    }
+    fn load(
+        &self,
+        path: &Path,
+        limits: &Limits,
+        _options: &super::LoadOptions,
+        _overlap: Option<super::Overlap<'_>>,
+    ) -> Result<Loaded> {
+        load(path, limits)
+    }
+    fn read_extensions(&self) -> &'static [&'static str] {
+        &["ktx2"]
+    }
+    fn stores(&self) -> Option<super::Stores> {
+        Some(super::Stores {
+            float: true,
+            integer: true,
+            blocks: true,
+            whole_chain: false,
+            round_up: false,
+            fingerprint: true,
+            supercompression: true,
+            channel_names: false,
+            file_per_level: false,
+            streamed_level0: false,
+            alpha: None,
+        })
+    }
+    fn storable(&self, f: Format) -> Format {
+        storable(f)
+    }
+    fn save(
+        &self,
+        levels: &[Texture],
+        _rounding: crate::mip::Rounding,
+        path: &Path,
+        options: &SaveOptions,
+    ) -> Result<()> {
+        save(levels, path, options)
+    }
+    fn save_blocks(&self, chain: &BlockChain, path: &Path, options: &SaveOptions) -> Result<()> {
+        save_blocks(chain, path, options)
+    }
+    fn stored_fingerprint(&self, path: &Path) -> Option<String> {
+        stored_fingerprint(path)
+    }
+}

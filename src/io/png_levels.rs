@@ -130,3 +130,61 @@ pub fn remove_stale(template: &Path, count: usize) -> Result<Stale> {
     }
     Ok(out)
 }
+
+/// One PNG per level in the container table (write only; PNG files are
+/// read by [`super::image_codecs`]): u8 or u16, straight alpha as PNG
+/// defines it, sizes rounded down or up, no fingerprint.
+pub struct PngLevels;
+
+impl super::Container for PngLevels {
+    fn id(&self) -> &'static str {
+        "png"
+    }
+    fn name(&self) -> &'static str {
+        "PNG"
+    }
+    fn tag(&self) -> &'static str {
+        "PngLevels"
+    }
+    fn summary(&self) -> &'static str {
+        "One PNG per level (`NAME_{level}.png`)"
+    }
+    fn stores(&self) -> Option<super::Stores> {
+        Some(super::Stores {
+            float: false,
+            integer: true,
+            blocks: false,
+            whole_chain: false,
+            round_up: true,
+            fingerprint: false,
+            supercompression: false,
+            channel_names: false,
+            file_per_level: true,
+            streamed_level0: false,
+            alpha: Some(crate::texel::AlphaMode::Straight),
+        })
+    }
+    fn output_hint(&self) -> String {
+        "a name with {level} for one PNG per level".into()
+    }
+    fn batch_path(&self, dir: &Path, stem: &str) -> PathBuf {
+        dir.join(format!("{stem}_{{level}}.png"))
+    }
+    fn default_type(&self, src: crate::texel::ChannelType) -> crate::texel::ChannelType {
+        use crate::texel::ChannelType::{U8, U16};
+        if src == U8 { U8 } else { U16 }
+    }
+    fn data_type(&self, main: crate::texel::ChannelType) -> crate::texel::ChannelType {
+        use crate::texel::ChannelType::{U8, U16};
+        if main == U16 { U16 } else { U8 }
+    }
+    fn save(
+        &self,
+        levels: &[Texture],
+        _rounding: crate::mip::Rounding,
+        path: &Path,
+        _options: &super::SaveOptions,
+    ) -> Result<()> {
+        save(levels, path)
+    }
+}

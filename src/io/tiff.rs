@@ -782,6 +782,36 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     Ok(Loaded { levels, info })
 }
 
+/// TIFF in the container table (read only): strips and tiles, chunky and
+/// planar, 8/16/32-bit, pages and mip-mapped directories.
+pub struct Tiff;
+
+impl super::Container for Tiff {
+    fn id(&self) -> &'static str {
+        "tiff"
+    }
+    fn name(&self) -> &'static str {
+        "TIFF"
+    }
+    fn detect(&self, magic: &[u8]) -> bool {
+        [b"II*\0", b"MM\0*", b"II+\0", b"MM\0+"]
+            .iter()
+            .any(|m| magic.starts_with(*m))
+    }
+    fn load(
+        &self,
+        path: &Path,
+        limits: &Limits,
+        options: &LoadOptions,
+        _overlap: Option<super::Overlap<'_>>,
+    ) -> Result<Loaded> {
+        load(path, limits, options)
+    }
+    fn read_extensions(&self) -> &'static [&'static str] {
+        &["tif", "tiff", "tx"]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -100,7 +100,7 @@ fn sample_refuses_nan_texels_as_mip_does() {
         &[t],
         Rounding::Down,
         &path,
-        OutputKind::Ktx2,
+        OutputKind::KTX2,
         &SaveOptions::default(),
     )
     .unwrap();

@@ -141,7 +141,7 @@ fn every_level_is_flipped_as_the_orientation_says() {
         &levels,
         Rounding::Down,
         &base,
-        OutputKind::Ktx2,
+        OutputKind::KTX2,
         &SaveOptions::default(),
     )
     .unwrap();

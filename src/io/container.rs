@@ -1,0 +1,416 @@
+//! The container table: one type per file container, one trait, one list.
+//!
+//! Each container (OpenEXR, KTX2, DDS, PNG levels, TIFF, and the codecs
+//! of the `image` crate) implements [`Container`] in its own file: how to
+//! recognise a file by its first bytes, how to load it within [`Limits`],
+//! what it can store (channel types, alpha convention, block formats,
+//! level rules, fingerprints) and how to save a chain or a block chain.
+//! [`CONTAINERS`] lists them in detection order; everything else —
+//! [`super::load`], [`OutputKind`], the `mip` pipeline's rules and the
+//! command line's `--ext` choices — reads this table instead of naming
+//! containers. Adding a container is a new file with an implementation
+//! and one entry in [`CONTAINERS`].
+
+use std::fmt;
+use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
+
+use super::{Limits, LoadOptions, Loaded, Overlap, SaveOptions};
+use crate::compress::BlockChain;
+use crate::error::{Error, Result};
+use crate::mip::Rounding;
+use crate::texel::{AlphaMode, ChannelType, Format};
+use crate::texture::Texture;
+
+/// What an output container can hold and how it names its files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stores {
+    /// Float channel types (f16, f32).
+    pub float: bool,
+    /// Integer channel types (u8, u16).
+    pub integer: bool,
+    /// Block-compressed levels ([`Container::save_blocks`]).
+    pub blocks: bool,
+    /// A mip-mapped file always holds the whole chain down to 1×1 (a
+    /// shorter chain is refused).
+    pub whole_chain: bool,
+    /// Level sizes rounded up (OpenEXR's `ROUND_UP`); otherwise only the
+    /// GPU rule, floor(size / 2^k).
+    pub round_up: bool,
+    /// The fingerprint of [`super::fingerprint`] is stored and read back
+    /// ([`Container::stored_fingerprint`]).
+    pub fingerprint: bool,
+    /// Supercompression of every level (KTX2's zstd and zlib).
+    pub supercompression: bool,
+    /// Channel names ([`SaveOptions::channel_names`]).
+    pub channel_names: bool,
+    /// One file per level, named from a `{level}` template.
+    pub file_per_level: bool,
+    /// Level 0 can be written row band by row band while it is built
+    /// (OpenEXR's tiles: [`super::exr::save_streamed`]).
+    pub streamed_level0: bool,
+    /// The alpha convention the container defines for colour with alpha;
+    /// `None` when its header says which (the source's is kept).
+    pub alpha: Option<AlphaMode>,
+}
+
+/// One file container (see the module docs).
+pub trait Container: Send + Sync {
+    /// Lower-case identifier and file extension: `exr`, `ktx2`, ...
+    fn id(&self) -> &'static str;
+    /// Display name: "OpenEXR", "KTX2", ...
+    fn name(&self) -> &'static str;
+    /// The name older fingerprints recorded for the output kind
+    /// (`kind=Exr`); kept so that `--update` still recognises them.
+    fn tag(&self) -> &'static str {
+        self.name()
+    }
+    /// One line for the command line's list of output containers.
+    fn summary(&self) -> &'static str {
+        self.name()
+    }
+
+    /// True when a file starting with `magic` (up to 12 bytes) is this
+    /// container's. The last entry of [`CONTAINERS`] takes every file no
+    /// other claims.
+    fn detect(&self, _magic: &[u8]) -> bool {
+        false
+    }
+    /// Load the file at `path` within `limits` (only called after
+    /// [`Container::detect`] claimed it). `overlap` is the caller's work
+    /// for the core a single-threaded decoder leaves idle
+    /// ([`super::load_overlapped`]); a loader that does not decode on one
+    /// thread never calls it.
+    fn load(
+        &self,
+        path: &Path,
+        _limits: &Limits,
+        _options: &LoadOptions,
+        _overlap: Option<Overlap<'_>>,
+    ) -> Result<Loaded> {
+        Err(Error::Decode {
+            format: self.name(),
+            reason: format!(
+                "parvo does not read {} files ({})",
+                self.name(),
+                path.display()
+            ),
+        })
+    }
+    /// File extensions (lower case) of the files it reads, for inputs
+    /// given as a directory.
+    fn read_extensions(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// True when [`LoadOptions::channels`] (choosing channels by name)
+    /// applies to this container's files.
+    fn selects_channels(&self) -> bool {
+        false
+    }
+
+    /// What the container stores as an output; `None` for containers
+    /// parvo only reads.
+    fn stores(&self) -> Option<Stores> {
+        None
+    }
+    /// How the command line names an output of this container in its
+    /// list of choices (".exr", "a name with {level} for ...").
+    fn output_hint(&self) -> String {
+        format!(".{}", self.id())
+    }
+    /// The output file for `stem` in directory `dir` (batches).
+    fn batch_path(&self, dir: &Path, stem: &str) -> PathBuf {
+        dir.join(format!("{stem}.{}", self.id()))
+    }
+    /// The channel type written when none is asked for, for a source of
+    /// type `src`.
+    fn default_type(&self, src: ChannelType) -> ChannelType {
+        src
+    }
+    /// The channel type of a one-channel data chain (roughness) beside a
+    /// main output of type `main`, when none is asked for or the asked
+    /// one is not storable.
+    fn data_type(&self, main: ChannelType) -> ChannelType {
+        main
+    }
+    /// `f` adjusted to what the container can describe (e.g. KTX2 has no
+    /// sRGB 16-bit formats: stored as linear).
+    fn storable(&self, f: Format) -> Format {
+        f
+    }
+    /// Write `levels` (level 0 first, sizes following `rounding`) to
+    /// `path` atomically. Called by [`save`] after the common checks.
+    fn save(
+        &self,
+        _levels: &[Texture],
+        _rounding: Rounding,
+        path: &Path,
+        _options: &SaveOptions,
+    ) -> Result<()> {
+        Err(not_writable(self.name(), path))
+    }
+    /// Write a block-compressed chain to `path` atomically.
+    fn save_blocks(&self, _chain: &BlockChain, _path: &Path, _options: &SaveOptions) -> Result<()> {
+        Err(Error::InvalidOption(format!(
+            "{} cannot store block-compressed texels: use {}",
+            self.name(),
+            or_list(&block_hints())
+        )))
+    }
+    /// The fingerprint stored in an existing output, or `None`.
+    fn stored_fingerprint(&self, _path: &Path) -> Option<String> {
+        None
+    }
+}
+
+fn not_writable(name: &str, path: &Path) -> Error {
+    Error::InvalidOption(format!(
+        "output `{}`: parvo does not write {name} files",
+        path.display()
+    ))
+}
+
+/// Every container, in detection order; the last reads whatever no other
+/// claims.
+pub static CONTAINERS: &[&dyn Container] = &[
+    &super::exr::OpenExr,
+    &super::ktx2::Ktx2,
+    &super::dds::Dds,
+    &super::tiff::Tiff,
+    &super::png_levels::PngLevels,
+    &super::image_codecs::ImageCodecs,
+];
+
+/// The container of a file whose first bytes are `magic`.
+pub fn detect(magic: &[u8]) -> &'static dyn Container {
+    CONTAINERS
+        .iter()
+        .copied()
+        .find(|c| c.detect(magic))
+        .unwrap_or(*CONTAINERS.last().expect("the table is not empty"))
+}
+
+/// Every extension some container reads (lower case), for inputs given
+/// as a directory.
+pub fn read_extensions() -> impl Iterator<Item = &'static str> {
+    CONTAINERS
+        .iter()
+        .flat_map(|c| c.read_extensions().iter().copied())
+}
+
+/// The containers parvo writes, in table order.
+pub fn outputs() -> impl Iterator<Item = OutputKind> {
+    CONTAINERS
+        .iter()
+        .copied()
+        .filter(|c| c.stores().is_some())
+        .map(OutputKind)
+}
+
+/// `a`, `a or b`, `a, b, or c`.
+fn or_list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [a] => a.clone(),
+        [a, b] => format!("{a} or {b}"),
+        [rest @ .., last] => format!("{}, or {last}", rest.join(", ")),
+    }
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn and_list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [a] => a.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
+fn block_hints() -> Vec<String> {
+    outputs()
+        .filter(|k| k.stores().blocks)
+        .map(|k| k.output_hint())
+        .collect()
+}
+
+/// An output container: an entry of [`CONTAINERS`] that writes files.
+#[derive(Clone, Copy)]
+pub struct OutputKind(&'static dyn Container);
+
+impl OutputKind {
+    /// Tiled, mip-mapped OpenEXR.
+    pub const EXR: OutputKind = OutputKind(&super::exr::OpenExr);
+    /// KTX 2.0.
+    pub const KTX2: OutputKind = OutputKind(&super::ktx2::Ktx2);
+    /// DDS.
+    pub const DDS: OutputKind = OutputKind(&super::dds::Dds);
+    /// One PNG per level, from a `{level}` name template.
+    pub const PNG_LEVELS: OutputKind = OutputKind(&super::png_levels::PngLevels);
+
+    /// The output container with identifier `id` (`exr`, `ktx2`, `dds`,
+    /// `png`).
+    pub fn from_id(id: &str) -> Option<OutputKind> {
+        outputs().find(|k| k.id() == id)
+    }
+
+    /// Pick the container for an output name: `{level}` in the name means
+    /// one file per level, otherwise the extension decides.
+    pub fn from_path(path: &Path) -> Result<Self> {
+        let s = path.to_string_lossy();
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let templated = s.contains("{level}");
+        if let Some(k) = outputs().find(|k| k.id() == ext && k.stores().file_per_level == templated)
+        {
+            return Ok(k);
+        }
+        if templated {
+            // One file per level is PNG's way; the other containers hold
+            // the whole chain in one file, and a `.exr` name must not get
+            // PNG bytes.
+            let per_level: Vec<String> = outputs()
+                .filter(|k| k.stores().file_per_level)
+                .map(|k| format!(".{}", k.id()))
+                .collect();
+            let whole: Vec<String> = outputs()
+                .filter(|k| !k.stores().file_per_level)
+                .map(|k| format!(".{}", k.id()))
+                .collect();
+            return Err(Error::InvalidOption(format!(
+                "output `{s}`: a {{level}} template writes one PNG per level, so it must end in {} \
+                 ({} hold the whole chain in one file: drop {{level}})",
+                or_list(&per_level),
+                and_list(&whole)
+            )));
+        }
+        let hints: Vec<String> = outputs().map(|k| k.output_hint()).collect();
+        Err(Error::InvalidOption(format!(
+            "output `{s}`: unknown extension (use {})",
+            or_list(&hints)
+        )))
+    }
+
+    /// The container's entry in the table.
+    pub fn container(self) -> &'static dyn Container {
+        self.0
+    }
+
+    /// What the container stores.
+    pub fn stores(self) -> Stores {
+        self.0
+            .stores()
+            .expect("an OutputKind is an output container")
+    }
+
+    /// Display name of the container ("OpenEXR", "PNG", ...).
+    pub fn name(self) -> &'static str {
+        self.0.name()
+    }
+
+    /// Identifier and extension (`exr`, `png`, ...).
+    pub fn id(self) -> &'static str {
+        self.0.id()
+    }
+
+    /// Channel types the container can store.
+    pub fn supports(self, ty: ChannelType) -> bool {
+        let s = self.stores();
+        if ty.is_float() { s.float } else { s.integer }
+    }
+}
+
+impl std::ops::Deref for OutputKind {
+    type Target = dyn Container;
+    fn deref(&self) -> &Self::Target {
+        self.0
+    }
+}
+
+impl PartialEq for OutputKind {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.id() == other.0.id()
+    }
+}
+
+impl Eq for OutputKind {}
+
+impl Hash for OutputKind {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        self.0.id().hash(state)
+    }
+}
+
+impl fmt::Debug for OutputKind {
+    /// The tag older fingerprints recorded (`Exr`, `PngLevels`, ...).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.0.tag())
+    }
+}
+
+/// Write `levels` (level 0 first, sizes following `rounding`) to `path`
+/// atomically in the container `kind`.
+pub fn save(
+    levels: &[Texture],
+    rounding: Rounding,
+    path: &Path,
+    kind: OutputKind,
+    options: &SaveOptions,
+) -> Result<()> {
+    let first = levels
+        .first()
+        .ok_or_else(|| Error::InvalidOption("nothing to write: no levels".into()))?;
+    if !kind.supports(first.channel_type()) {
+        return Err(Error::InvalidOption(format!(
+            "{kind:?} output cannot store {} texels",
+            first.channel_type()
+        )));
+    }
+    for (k, l) in levels.iter().enumerate() {
+        let want = crate::mip::level_size(first.width(), first.height(), k as u32, rounding);
+        if (l.width(), l.height()) != want || l.format() != first.format() {
+            return Err(Error::InvalidOption(format!(
+                "level {k} is {}x{} {}, expected {}x{} {}",
+                l.width(),
+                l.height(),
+                l.format(),
+                want.0,
+                want.1,
+                first.format()
+            )));
+        }
+    }
+    kind.0.save(levels, rounding, path, options)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Identifiers are unique, every output has a distinct tag, and
+    /// `from_path` finds each output by its own batch name.
+    #[test]
+    fn the_table_is_consistent() {
+        let ids: Vec<_> = CONTAINERS.iter().map(|c| c.id()).collect();
+        let mut sorted = ids.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted.len(), ids.len(), "{ids:?}");
+        for k in outputs() {
+            let p = k.batch_path(Path::new("dir"), "stem");
+            assert_eq!(OutputKind::from_path(&p).unwrap(), k, "{}", p.display());
+            assert!(k.supports(k.default_type(ChannelType::U8)), "{}", k.id());
+            assert!(k.supports(k.default_type(ChannelType::F32)), "{}", k.id());
+        }
+    }
+
+    #[test]
+    fn lists_read_as_english() {
+        let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+        assert_eq!(or_list(&s(&["a", "b", "c"])), "a, b, or c");
+        assert_eq!(or_list(&s(&["a", "b"])), "a or b");
+        assert_eq!(and_list(&s(&["a", "b", "c"])), "a, b and c");
+        assert_eq!(and_list(&s(&["a"])), "a");
+    }
+}
