@@ -36,18 +36,18 @@ fuzz_target!(|data: &[u8]| {
     let f = levels[0].format();
     let opts = SaveOptions::default();
     for (kind, name) in [
-        (OutputKind::Ktx2, "o.ktx2"),
-        (OutputKind::Dds, "o.dds"),
-        (OutputKind::PngLevels, "o_{level}.png"),
-        (OutputKind::Exr, "o.exr"),
+        (OutputKind::KTX2, "o.ktx2"),
+        (OutputKind::DDS, "o.dds"),
+        (OutputKind::PNG_LEVELS, "o_{level}.png"),
+        (OutputKind::EXR, "o.exr"),
     ] {
         let out_f = match kind {
-            OutputKind::Exr => Format::new(f.channels, ChannelType::F16, ColorSpace::Linear),
-            OutputKind::PngLevels if f.channel_type.is_float() => {
+            OutputKind::EXR => Format::new(f.channels, ChannelType::F16, ColorSpace::Linear),
+            OutputKind::PNG_LEVELS if f.channel_type.is_float() => {
                 Format::new(f.channels, ChannelType::U16, ColorSpace::Linear)
             }
-            OutputKind::Ktx2 => io::ktx2::storable(f),
-            OutputKind::Dds => io::dds::storable(f),
+            OutputKind::KTX2 => io::ktx2::storable(f),
+            OutputKind::DDS => io::dds::storable(f),
             _ => f,
         };
         let conv: Vec<_> = levels
