@@ -5,9 +5,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use parvo::io::{self, Limits, OutputKind, SaveOptions};
+use parvo::io::{self, Limits, SaveOptions};
 use parvo::mip::{self, MipOptions, Rounding};
-use parvo::texel::{ChannelType, ColorSpace, Format};
 
 const EXTS: [&str; 7] = ["png", "jpg", "tif", "hdr", "exr", "ktx2", "dds"];
 
@@ -35,27 +34,19 @@ fuzz_target!(|data: &[u8]| {
     let levels = chain.into_levels();
     let f = levels[0].format();
     let opts = SaveOptions::default();
-    for (kind, name) in [
-        (OutputKind::KTX2, "o.ktx2"),
-        (OutputKind::DDS, "o.dds"),
-        (OutputKind::PNG_LEVELS, "o_{level}.png"),
-        (OutputKind::EXR, "o.exr"),
-    ] {
-        let out_f = match kind {
-            OutputKind::EXR => Format::new(f.channels, ChannelType::F16, ColorSpace::Linear),
-            OutputKind::PNG_LEVELS if f.channel_type.is_float() => {
-                Format::new(f.channels, ChannelType::U16, ColorSpace::Linear)
-            }
-            OutputKind::KTX2 => io::ktx2::storable(f),
-            OutputKind::DDS => io::dds::storable(f),
-            _ => f,
+    // Every output container of the table, in the format `parvo mip`
+    // would write for this source.
+    for kind in io::container::outputs() {
+        let name = kind.batch_path(dir.path(), "o");
+        let Ok(out_f) = parvo::pipeline::output_format(f, kind, &Default::default()) else {
+            continue;
         };
         let conv: Vec<_> = levels
             .iter()
-            .filter_map(|l| l.convert(out_f.with_alpha(f.alpha)).ok())
+            .filter_map(|l| l.convert(out_f).ok())
             .collect();
         if conv.len() == levels.len() {
-            let _ = io::save(&conv, Rounding::Down, &dir.path().join(name), kind, &opts);
+            let _ = io::save(&conv, Rounding::Down, &name, kind, &opts);
         }
     }
 });
