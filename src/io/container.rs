@@ -5,17 +5,18 @@
 //! recognise a file by its first bytes, how to load it within [`Limits`],
 //! what it can store (channel types, alpha convention, block formats,
 //! level rules, fingerprints) and how to save a chain or a block chain.
-//! [`CONTAINERS`] lists them in detection order; everything else —
+//! [`CONTAINERS`] (in `io/mod.rs`, beside the module declarations) lists
+//! them in detection order; everything else —
 //! [`super::load`], [`OutputKind`], the `mip` pipeline's rules and the
 //! command line's `--ext` choices — reads this table instead of naming
-//! containers. Adding a container is a new file with an implementation
-//! and one entry in [`CONTAINERS`].
+//! containers. Adding a container is a new file with an implementation,
+//! and its `mod` line and entry in [`CONTAINERS`] in `io/mod.rs`.
 
 use std::fmt;
 use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 
-use super::{Limits, LoadOptions, Loaded, Overlap, SaveOptions};
+use super::{CONTAINERS, Limits, LoadOptions, Loaded, Overlap, SaveOptions};
 use crate::compress::BlockChain;
 use crate::error::{Error, Result};
 use crate::mip::Rounding;
@@ -170,16 +171,6 @@ fn not_writable(name: &str, path: &Path) -> Error {
     ))
 }
 
-/// Every container, in detection order; the last reads whatever no other
-/// claims.
-pub static CONTAINERS: &[&dyn Container] = &[
-    &super::exr::OpenExr,
-    &super::ktx2::Ktx2,
-    &super::dds::Dds,
-    &super::tiff::Tiff,
-    &super::png_levels::PngLevels,
-    &super::image_codecs::ImageCodecs,
-];
 
 /// The container of a file whose first bytes are `magic`.
 pub fn detect(magic: &[u8]) -> &'static dyn Container {

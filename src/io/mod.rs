@@ -40,7 +40,19 @@ use crate::texel::{ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::Wrap;
 
-pub use container::{CONTAINERS, Container, OutputKind, Stores, save};
+pub use container::{Container, OutputKind, Stores, save};
+
+/// The container table ([`container`]): every container, in detection
+/// order; the last reads whatever no other claims. A new container is a
+/// module above and one entry here.
+pub static CONTAINERS: &[&dyn Container] = &[
+    &exr::OpenExr,
+    &ktx2::Ktx2,
+    &dds::Dds,
+    &tiff::Tiff,
+    &png_levels::PngLevels,
+    &image_codecs::ImageCodecs,
+];
 pub use limits::Limits;
 
 /// A file format parvo reads or writes.
