@@ -86,6 +86,7 @@ pub mod pipeline;
 pub mod sample;
 pub mod sat;
 pub mod scene;
+pub mod setting;
 pub mod shade;
 pub mod store;
 pub mod texel;

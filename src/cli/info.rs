@@ -64,13 +64,13 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
             }
             Err(e) => {
                 failed = true;
-                eprintln!("parvo: {file}: {e}");
+                eprintln!("parvo: {file}: {}", super::words(&e));
                 if args.json {
                     // One object per file, failed ones included (as `mip
                     // --json` does), so a script sees every file.
                     println!(
                         "{}",
-                        serde_json::json!({"file": file, "status": "failed", "error": e.to_string()})
+                        serde_json::json!({"file": file, "status": "failed", "error": super::words(&e)})
                     );
                 }
             }
@@ -148,7 +148,7 @@ fn text(file: &str, l: &Loaded) -> String {
             .unwrap_or_else(|| "(not recorded)".into())
     );
     for n in &i.notes {
-        let _ = writeln!(s, "  note:       {n}");
+        let _ = writeln!(s, "  note:       {}", super::words(n));
     }
     if !i.attributes.is_empty() {
         let _ = writeln!(s, "  metadata:");
@@ -183,7 +183,7 @@ fn json(file: &str, l: &Loaded) -> String {
         })).collect::<Vec<_>>(),
         "wrapmodes": i.wrap.map(|w| format!("{},{}", w.u.oiio_name(), w.v.oiio_name())),
         "attributes": i.attributes.iter().cloned().collect::<std::collections::BTreeMap<_, _>>(),
-        "notes": i.notes,
+        "notes": i.notes.iter().map(super::words).collect::<Vec<_>>(),
     })
     .to_string()
 }

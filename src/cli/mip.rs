@@ -581,7 +581,7 @@ fn roughness_settings(args: &MipArgs) -> Result<Option<RoughnessSettings>, Strin
 
 pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     let usage = |msg: String| {
-        eprintln!("parvo: {msg}");
+        eprintln!("parvo: {}", super::words(msg));
         Ok(ExitCode::from(2))
     };
     if let Some(n) = args.threads {
@@ -688,8 +688,8 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
             None => println!("{s}"),
         };
         let warn = |s: String| match &bar {
-            Some(b) => b.suspend(|| eprintln!("{s}")),
-            None => eprintln!("{s}"),
+            Some(b) => b.suspend(|| eprintln!("{}", super::words(&s))),
+            None => eprintln!("{}", super::words(&s)),
         };
         match result {
             Ok(o) => {
@@ -872,7 +872,7 @@ fn json_line(job: &Job, o: &Outcome, secs: f64) -> String {
                 "encode_seconds": l.encode_s,
             })).collect::<Vec<_>>(),
         })),
-        "notes": o.notes,
+        "notes": o.notes.iter().map(super::words).collect::<Vec<_>>(),
     })
     .to_string()
 }

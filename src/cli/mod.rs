@@ -36,6 +36,29 @@ enum Command {
     Tradeoff(Box<tradeoff::TradeoffArgs>),
 }
 
+/// The flag of each setting a library message names.
+fn flag(s: parvo::setting::Setting) -> &'static str {
+    use parvo::setting::Setting;
+    match s {
+        Setting::MaxWidth => "--max-width",
+        Setting::MaxHeight => "--max-height",
+        Setting::MaxAlloc => "--max-alloc",
+        Setting::Channels => "--channels",
+        Setting::Subimage => "--subimage",
+        Setting::Color => "--color",
+        Setting::NoAutoOrient => "--no-auto-orient",
+        Setting::Wrap => "--wrap",
+        Setting::Levels => "--levels",
+        Setting::Alpha => "--alpha",
+    }
+}
+
+/// Library text (an error, a note) in the command line's words: each
+/// setting it names as its flag.
+pub(crate) fn words(text: impl std::fmt::Display) -> String {
+    parvo::setting::respell(&text.to_string(), flag)
+}
+
 /// The CLI's words for a library error: the error and, where a flag
 /// deals with it, that flag.
 pub(crate) fn error_text(e: &parvo::Error) -> String {
@@ -46,8 +69,8 @@ pub(crate) fn error_text(e: &parvo::Error) -> String {
         _ => None,
     };
     match hint {
-        Some(h) => format!("{e} ({h})"),
-        None => e.to_string(),
+        Some(h) => format!("{} ({h})", words(e)),
+        None => words(e),
     }
 }
 
@@ -93,7 +116,7 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("parvo: {e:#}");
+            eprintln!("parvo: {}", words(format!("{e:#}")));
             ExitCode::from(1)
         }
     }

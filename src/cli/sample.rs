@@ -212,7 +212,7 @@ impl SampleArgs {
 pub fn run(args: SampleArgs) -> Result<ExitCode> {
     let mut options = args.options();
     if let Err(e) = options.validate() {
-        eprintln!("parvo: {e}");
+        eprintln!("parvo: {}", super::words(&e));
         return Ok(ExitCode::from(2));
     }
     // A mip-mapped EXR/KTX2/DDS keeps its own levels; anything else gets

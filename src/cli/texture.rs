@@ -65,7 +65,7 @@ impl TextureArgs {
             .then(|| io::assumed_color_note(&loaded.info, &loaded.base().format()))
             .flatten();
         for n in loaded.info.notes.iter().chain(&assumed) {
-            eprintln!("parvo: {spec}: {n}");
+            eprintln!("parvo: {spec}: {}", super::words(n));
         }
         Ok(loaded)
     }

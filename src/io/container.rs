@@ -171,7 +171,6 @@ fn not_writable(name: &str, path: &Path) -> Error {
     ))
 }
 
-
 /// The container of a file whose first bytes are `magic`.
 pub fn detect(magic: &[u8]) -> &'static dyn Container {
     CONTAINERS

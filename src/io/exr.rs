@@ -28,6 +28,8 @@
 
 use std::fmt;
 use std::path::Path;
+
+use crate::setting::Setting;
 use std::str::FromStr;
 
 use ::exr::block::chunk::{Chunk, CompressedBlock, CompressedTileBlock, TileCoordinates};
@@ -190,9 +192,10 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
     let have: Vec<_> = levels.iter().map(|l| (l.width(), l.height())).collect();
     if levels.len() > 1 && have != want {
         return Err(encode_err(format!(
-            "a mip-mapped OpenEXR file holds the full chain of {} levels, got {} (do not limit --levels for .exr)",
+            "a mip-mapped OpenEXR file holds the full chain of {} levels, got {} (do not limit {} for .exr)",
             want.len(),
-            levels.len()
+            levels.len(),
+            crate::setting::Setting::Levels,
         )));
     }
     let (header, tiles) = plan(w, h, first.format(), levels.len() > 1, rounding, opts)?;
@@ -779,7 +782,8 @@ fn choose_channels(
         Some(req) => {
             if req.is_empty() || req.len() > 4 {
                 return Err(Error::InvalidOption(format!(
-                    "--channels takes 1 to 4 names, got {}",
+                    "{} takes 1 to 4 names, got {}",
+                    Setting::Channels,
                     req.len()
                 )));
             }
@@ -787,12 +791,14 @@ fn choose_channels(
             for r in req {
                 let i = names.iter().position(|n| n == r).ok_or_else(|| {
                     Error::InvalidOption(format!(
-                        "--channels: no channel `{r}` (the file has {list})"
+                        "{}: no channel `{r}` (the file has {list})",
+                        Setting::Channels
                     ))
                 })?;
                 if v.contains(&i) {
                     return Err(Error::InvalidOption(format!(
-                        "--channels: `{r}` given twice"
+                        "{}: `{r}` given twice",
+                        Setting::Channels
                     )));
                 }
                 v.push(i);
@@ -828,8 +834,9 @@ fn choose_channels(
                 });
                 pick.ok_or_else(|| {
                     decode_err(format!(
-                        "{} channels ({list}) and no layer with R,G,B or Y: parvo reads 1 to 4 channels, pick them with --channels",
-                        names.len()
+                        "{} channels ({list}) and no layer with R,G,B or Y: parvo reads 1 to 4 channels, pick them with {}",
+                        names.len(),
+                        Setting::Channels
                     ))
                 })?
             }
@@ -855,7 +862,10 @@ fn choose_channels(
         };
         let mut s = format!("channels {} read as {layout}", chosen.join(","));
         if chosen.len() < names.len() {
-            s.push_str(&format!(" (the file has {list}; --channels picks others)"));
+            s.push_str(&format!(
+                " (the file has {list}; {} picks others)",
+                Setting::Channels
+            ));
         }
         if !alpha && chosen.iter().any(|c| is_alpha_name(c)) {
             s.push_str("; the A channel is not last of 2 or 4, so it is data");
@@ -875,7 +885,8 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
     let part = options.subimage;
     let header = meta.headers.get(part).ok_or_else(|| {
         Error::InvalidOption(format!(
-            "--subimage {part}: the file has {parts} part{}",
+            "{} {part}: the file has {parts} part{}",
+            Setting::Subimage,
             if parts == 1 { "" } else { "s" }
         ))
     })?;
@@ -885,12 +896,13 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
     let mut notes = Vec::new();
     if parts > 1 {
         notes.push(format!(
-            "multi-part file: using part {part} ({}) of {parts}; --subimage N picks another",
+            "multi-part file: using part {part} ({}) of {parts}; {} N picks another",
             header
                 .own_attributes
                 .layer_name
                 .as_ref()
-                .map_or_else(|| "unnamed".to_string(), |t| format!("`{t}`"))
+                .map_or_else(|| "unnamed".to_string(), |t| format!("`{t}`")),
+            Setting::Subimage
         ));
     }
     let (w, h) = (header.layer_size.width(), header.layer_size.height());

@@ -8,6 +8,7 @@ use std::path::Path;
 use super::container::Container;
 use super::{FileFormat, Limits, LoadOptions, Loaded, Overlap, SourceInfo, image_errors, orient};
 use crate::error::{Error, Result};
+use crate::setting::Setting;
 use crate::texel::{ChannelType, ColorSpace, Format};
 use crate::texture::Texture;
 
@@ -393,11 +394,13 @@ fn load_image(
         if options.auto_orient {
             tex = orient(&tex, orientation)?;
             notes.push(format!(
-                "EXIF orientation {orientation} applied (--no-auto-orient keeps the stored order)"
+                "EXIF orientation {orientation} applied ({} keeps the stored order)",
+                Setting::NoAutoOrient
             ));
         } else {
             notes.push(format!(
-                "EXIF orientation {orientation} not applied (--no-auto-orient)"
+                "EXIF orientation {orientation} not applied ({})",
+                Setting::NoAutoOrient
             ));
         }
     }

@@ -338,9 +338,10 @@ impl Supercompression {
 fn decompress(scheme: u32, data: &[u8], len: u64, limits: &Limits) -> Result<Vec<u8>> {
     if len > limits.max_alloc {
         return Err(Error::Limits(format!(
-            "a level declares {} MiB uncompressed, more than the {} MiB allowed (raise with --max-alloc)",
+            "a level declares {} MiB uncompressed, more than the {} MiB allowed (raise with {})",
             len >> 20,
-            limits.max_alloc >> 20
+            limits.max_alloc >> 20,
+            crate::setting::Setting::MaxAlloc
         )));
     }
     let len = len as usize;
@@ -678,9 +679,10 @@ fn read_bytes(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
         .len();
     if len > limits.max_alloc {
         return Err(Error::Limits(format!(
-            "file is {} MiB, more than the {} MiB allowed (raise with --max-alloc)",
+            "file is {} MiB, more than the {} MiB allowed (raise with {})",
             len >> 20,
-            limits.max_alloc >> 20
+            limits.max_alloc >> 20,
+            crate::setting::Setting::MaxAlloc
         )));
     }
     std::fs::read(path).map_err(|e| Error::Io {

@@ -7,6 +7,7 @@
 //! [`Limits::check`] on their headers.
 
 use crate::error::{Error, Result};
+use crate::setting::Setting;
 
 /// Maximum width, height and allocation a decoder may use.
 ///
@@ -50,15 +51,19 @@ impl Limits {
     pub fn check(&self, width: u64, height: u64, bytes: u64) -> Result<()> {
         if width > self.max_width as u64 || height > self.max_height as u64 {
             return Err(Error::Limits(format!(
-                "image declares {width}x{height}, more than the {}x{} allowed (raise with --max-width/--max-height)",
-                self.max_width, self.max_height
+                "image declares {width}x{height}, more than the {}x{} allowed (raise with {}/{})",
+                self.max_width,
+                self.max_height,
+                Setting::MaxWidth,
+                Setting::MaxHeight
             )));
         }
         if bytes > self.max_alloc {
             return Err(Error::Limits(format!(
-                "image needs {} MiB, more than the {} MiB allowed (raise with --max-alloc)",
+                "image needs {} MiB, more than the {} MiB allowed (raise with {})",
                 bytes.div_ceil(1 << 20),
-                self.max_alloc / (1 << 20)
+                self.max_alloc / (1 << 20),
+                Setting::MaxAlloc
             )));
         }
         Ok(())

@@ -36,6 +36,7 @@ use half::slice::HalfFloatSliceExt;
 
 use crate::error::{Error, Result};
 use crate::mip::{self, MipChain, MipOptions, NanPolicy, Rounding};
+use crate::setting::Setting;
 use crate::texel::{ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::Wrap;
@@ -227,13 +228,15 @@ pub fn assumed_color_note(info: &SourceInfo, f: &Format) -> Option<String> {
     Some(match f.color_space {
         ColorSpace::Srgb => format!(
             "the {} file does not say how its values encode colour: read as sRGB-encoded colour, \
-             as OpenImageIO reads such files (--color linear reads them as data, e.g. a height map)",
-            info.format
+             as OpenImageIO reads such files ({} linear reads them as data, e.g. a height map)",
+            info.format,
+            Setting::Color
         ),
         ColorSpace::Linear => format!(
             "the {} file does not say how its values encode colour: read as linear values, as \
-             OpenImageIO reads such files (--color srgb decodes them as sRGB)",
-            info.format
+             OpenImageIO reads such files ({} srgb decodes them as sRGB)",
+            info.format,
+            Setting::Color
         ),
     })
 }
@@ -247,7 +250,8 @@ pub(crate) fn recorded_wrap(text: Option<&str>, notes: &mut Vec<String>) -> Opti
         Err(_) => {
             notes.push(format!(
                 "wrap modes `{t}` not understood (expected MODE or U,V of repeat/periodic, mirror, \
-                 clamp, black/border, mirror-clamp): repeat applies unless --wrap says otherwise"
+                 clamp, black/border, mirror-clamp): repeat applies unless {} says otherwise",
+                Setting::Wrap
             ));
             None
         }
@@ -505,9 +509,10 @@ fn load_stored(
     let container = container::detect(magic);
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         if options.channels.is_some() && !container.selects_channels() {
-            return Err(Error::InvalidOption(
-                "--channels selects channels of OpenEXR files; this input is not one".into(),
-            ));
+            return Err(Error::InvalidOption(format!(
+                "{} selects channels of OpenEXR files; this input is not one",
+                Setting::Channels
+            )));
         }
         container.load(path, limits, options, overlap)
     }))

@@ -62,6 +62,7 @@ use self::errors::{alloc_limit, words};
 use super::{Environment, FileFormat, Limits, LoadOptions, Loaded, SourceInfo};
 use crate::error::{Error, Result};
 use crate::mip::Rounding;
+use crate::setting::Setting;
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
@@ -283,7 +284,7 @@ impl Reader<'_> {
                     AlphaMode::Premultiplied,
                     Some(
                         "no ExtraSamples tag: the last channel is taken as associated alpha, as \
-                         OpenImageIO does (--alpha straight or none overrides)",
+                         OpenImageIO does",
                     ),
                 ),
                 None => (AlphaMode::None, None),
@@ -600,14 +601,16 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     let first = if mipmapped { 0 } else { options.subimage };
     if first >= pages {
         return Err(Error::InvalidOption(format!(
-            "--subimage {first}: the file has {pages} page{}",
+            "{} {first}: the file has {pages} page{}",
+            Setting::Subimage,
             if pages == 1 { "" } else { "s" }
         )));
     }
     if mipmapped && options.subimage != 0 {
-        return Err(Error::InvalidOption(
-            "--subimage: this TIFF is a mip-mapped texture, its directories are its levels".into(),
-        ));
+        return Err(Error::InvalidOption(format!(
+            "{}: this TIFF is a mip-mapped texture, its directories are its levels",
+            Setting::Subimage
+        )));
     }
     let count = if mipmapped { pages } else { 1 };
     for d in &chain.dirs[first..first + count] {
@@ -617,7 +620,8 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     let mut notes = Vec::new();
     if !mipmapped && pages > 1 {
         notes.push(format!(
-            "multi-page TIFF: using page {first} of {pages}; --subimage N picks another"
+            "multi-page TIFF: using page {first} of {pages}; {} N picks another",
+            Setting::Subimage
         ));
     }
     notes.extend(chain.notes.iter().cloned());
@@ -716,7 +720,10 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
             .saturating_mul(if count > 1 { 2 } else { 1 }),
     )?;
     if let Some(n) = dir0.alpha_note {
-        notes.push(n.to_string());
+        notes.push(format!(
+            "{n} ({} straight or none overrides)",
+            Setting::Alpha
+        ));
     }
     if let Some(map) = &dir0.palette
         && map.iter().any(|&v| v % 257 != 0)
@@ -757,13 +764,15 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
                 *l = super::orient(l, dir0.orientation)?;
             }
             notes.push(format!(
-                "TIFF orientation {} applied (--no-auto-orient keeps the stored order)",
-                dir0.orientation
+                "TIFF orientation {} applied ({} keeps the stored order)",
+                dir0.orientation,
+                Setting::NoAutoOrient
             ));
         } else {
             notes.push(format!(
-                "TIFF orientation {} not applied (--no-auto-orient)",
-                dir0.orientation
+                "TIFF orientation {} not applied ({})",
+                dir0.orientation,
+                Setting::NoAutoOrient
             ));
         }
     }
