@@ -81,14 +81,8 @@ impl TextureStore {
     /// A store of a loaded file (see [`TextureStore::load`]).
     #[cfg(feature = "io")]
     pub fn from_loaded(loaded: crate::io::Loaded) -> Self {
-        let wrap = loaded.info.wrap.unwrap_or_default();
-        let mut s = Self::from_levels(
-            loaded.levels,
-            MipOptions {
-                wrap,
-                ..Default::default()
-            },
-        );
+        let options = loaded.chain_options();
+        let mut s = Self::from_levels(loaded.levels, options);
         s.blocks = loaded.info.blocks;
         s
     }

@@ -198,17 +198,25 @@ impl Loaded {
         self.levels.swap_remove(0)
     }
 
+    /// The options a chain of this file is built or kept with: the file's
+    /// level rounding, and its wrap modes (repeat when it records none).
+    /// [`Loaded::into_chain`] and [`crate::store::TextureStore`] both use
+    /// them.
+    pub fn chain_options(&self) -> MipOptions {
+        MipOptions {
+            rounding: self.info.rounding,
+            wrap: self.info.wrap.unwrap_or_default(),
+            ..MipOptions::default()
+        }
+    }
+
     /// Consume into a mip chain: the file's own levels when it stores
     /// them, otherwise a box-filtered chain built from level 0 (wrap modes
     /// from the file when it names them, else repeat); and the block
     /// format the file stored its levels in, if any.
     pub fn into_chain(self) -> Result<(MipChain, Option<crate::compress::BlockFormat>)> {
         let blocks = self.info.blocks;
-        let options = MipOptions {
-            rounding: self.info.rounding,
-            wrap: self.info.wrap.unwrap_or_default(),
-            ..MipOptions::default()
-        };
+        let options = self.chain_options();
         let chain = if self.levels.len() > 1 {
             MipChain::from_levels(self.levels, options)?
         } else {

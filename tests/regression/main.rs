@@ -44,6 +44,7 @@ mod sample_ignores_recorded_wrap_modes;
 mod sampler_storage_widened;
 mod sat_rect_end_just_below_zero_read_a_texel_off;
 mod subcommand_long_help_hidden;
+mod texture_store_ignored_file_rounding;
 mod texture_store_sat_kept_first_callers_wrap;
 mod tiff_associated_alpha_premultiplied_twice;
 mod tiff_rgb_data_sample_dropped;
