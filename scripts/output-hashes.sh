@@ -27,7 +27,9 @@ mip() { # mip NAME ARGS...: write out/NAME.* and record every file it wrote
     local rc=0
     (cd "o$n" && "$bin" mip "$@" >/dev/null 2>"../o$n.err") || rc=$?
     if [ "$rc" != 0 ]; then
-        echo "$name: exit $rc $(tr '\n' ' ' <"o$n.err")"
+        # Paths inside the checkout are printed relative to it, so two
+        # checkouts' runs compare.
+        echo "$name: exit $rc $(tr '\n' ' ' <"o$n.err" | sed "s#$here/##g")"
     fi
     find "o$n" -type f | sort | while read -r f; do
         echo "$name ${f#o$n/} $(sha256sum "$f" | cut -c1-16)"
