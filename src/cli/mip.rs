@@ -123,7 +123,7 @@ fn ext_parser() -> impl clap::builder::TypedValueParser<Value = OutputKind> {
     PossibleValuesParser::new(
         io::container::outputs().map(|k| PossibleValue::new(k.id()).help(k.summary())),
     )
-    .map(|id| OutputKind::from_id(&id).expect("a listed container"))
+    .try_map(|id| OutputKind::from_id(&id).ok_or_else(|| format!("no output container `{id}`")))
 }
 
 /// Arguments of `parvo mip`.

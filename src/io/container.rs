@@ -55,6 +55,23 @@ pub struct Stores {
     pub alpha: Option<AlphaMode>,
 }
 
+impl Stores {
+    /// Stores nothing (a read-only container).
+    pub const NOTHING: Stores = Stores {
+        float: false,
+        integer: false,
+        blocks: false,
+        whole_chain: false,
+        round_up: false,
+        fingerprint: false,
+        supercompression: false,
+        channel_names: false,
+        file_per_level: false,
+        streamed_level0: false,
+        alpha: None,
+    };
+}
+
 /// One file container (see the module docs).
 pub trait Container: Send + Sync {
     /// Lower-case identifier and file extension: `exr`, `ktx2`, ...
@@ -171,13 +188,14 @@ fn not_writable(name: &str, path: &Path) -> Error {
     ))
 }
 
-/// The container of a file whose first bytes are `magic`.
-pub fn detect(magic: &[u8]) -> &'static dyn Container {
+/// The container of a file whose first bytes are `magic` (`None` only
+/// if the table were empty).
+pub fn detect(magic: &[u8]) -> Option<&'static dyn Container> {
     CONTAINERS
         .iter()
         .copied()
         .find(|c| c.detect(magic))
-        .unwrap_or(*CONTAINERS.last().expect("the table is not empty"))
+        .or(CONTAINERS.last().copied())
 }
 
 /// Every extension some container reads (lower case), for inputs given
@@ -289,9 +307,9 @@ impl OutputKind {
 
     /// What the container stores.
     pub fn stores(self) -> Stores {
-        self.0
-            .stores()
-            .expect("an OutputKind is an output container")
+        // Every OutputKind is made from an entry that stores (`outputs`,
+        // the constants below): `NOTHING` is never seen.
+        self.0.stores().unwrap_or(Stores::NOTHING)
     }
 
     /// Display name of the container ("OpenEXR", "PNG", ...).

@@ -514,7 +514,10 @@ fn load_stored(
     // The decoders are dependencies; a panic in one on a malformed file
     // becomes a decode error, never a crash of the caller. (What `overlap`
     // did before a panic is the caller's buffers, valid as they are.)
-    let container = container::detect(magic);
+    let container = container::detect(magic).ok_or(Error::Decode {
+        format: "input",
+        reason: "no container reads it".into(),
+    })?;
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         if options.channels.is_some() && !container.selects_channels() {
             return Err(Error::InvalidOption(format!(
