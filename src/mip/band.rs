@@ -29,10 +29,6 @@ use crate::error::{Error, Result};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
-/// Most levels [`Streamer`] makes band by band (bands of up to
-/// 2^4 = 16 level-0 rows: a band of 16384-wide RGBA f32 is 4 MiB).
-const STREAM_LEVELS: u32 = 4;
-
 /// Progress through a chain of `sizes`, counting the texels of levels
 /// above 0.
 fn chain_progress(sizes: &[(u32, u32)], levels_done: u32, texels_done: u64) -> Progress {
@@ -246,18 +242,9 @@ impl<'a> Streamer<'a> {
     /// (whatever its texels).
     fn plan(w: u32, h: u32, options: &MipOptions) -> Option<(Vec<(u32, u32)>, usize)> {
         let sizes = super::level_sizes(w, h, options.rounding, options.max_levels);
-        let m = w
-            .trailing_zeros()
-            .min(h.trailing_zeros())
-            .min(STREAM_LEVELS)
-            .min(sizes.len() as u32 - 1) as usize;
-        let applies = options.filter == MipFilter::Box
-            && options.fast_paths
-            && options.alpha_coverage.is_none()
-            && !options.normal_map
-            && m >= 1
-            && (0..=m).all(|k| sizes[k] == (w >> k, h >> k));
-        applies.then_some((sizes, m))
+        // The whole-level build's own rule for its band-by-band levels.
+        let m = super::stream::levels(&sizes, options);
+        (m >= 1 && !options.normal_map).then_some((sizes, m))
     }
 
     /// Zeroed buffers for levels 1..=m in `out`.
@@ -389,15 +376,9 @@ impl<'a> Streamer<'a> {
                     kept.copy_from_slice(cur);
                     break;
                 }
-                let (nw, nr) = (lw / 2, lr / 2);
-                next.resize(nw * nr * ch, 0.0);
-                for (r, o) in next.chunks_exact_mut(nw * ch).enumerate() {
-                    let r0 = &cur[2 * r * lw * ch..(2 * r + 1) * lw * ch];
-                    let r1 = &cur[(2 * r + 1) * lw * ch..(2 * r + 2) * lw * ch];
-                    super::fast::box_row_f32(r0, r1, o, ch, straight);
-                }
+                super::stream::reduce_band(cur, lw, lr, ch, straight, next);
                 std::mem::swap(cur, next);
-                (lw, lr) = (nw, nr);
+                (lw, lr) = (lw / 2, lr / 2);
             }
             Ok(())
         };
