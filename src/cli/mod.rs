@@ -39,6 +39,9 @@ enum Command {
 /// The CLI's words for a library error: the error and, where a flag
 /// deals with it, that flag.
 pub(crate) fn error_text(e: &parvo::Error) -> String {
+    if let parvo::Error::Usage(u) = e {
+        return format!("invalid option: {}", mip::usage_text(u));
+    }
     let hint = match e {
         parvo::Error::NonFinite { .. } => {
             Some("--fixnan black or --fixnan neighbors replaces such values")
