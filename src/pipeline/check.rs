@@ -6,7 +6,7 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use super::{Job, RoughnessSource, Settings};
+use super::{Job, RoughnessSettings, RoughnessSource, Settings};
 use crate::compress::BlockFormat;
 use crate::error::{Error, Result};
 use crate::io::OutputKind;
@@ -221,40 +221,7 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
         });
     }
     if let Some(r) = &s.roughness {
-        if !s.normal_map {
-            return bad(Usage::RoughnessNeedsNormalMap);
-        }
-        if jobs.len() > 1 && r.output.is_some() {
-            return bad(Usage::RoughnessOutputOfBatch);
-        }
-        if r.pack_alpha && r.output.is_some() {
-            return bad(Usage::RoughnessPackedAndWritten);
-        }
-        if !r.pack_alpha && r.output.is_none() {
-            return bad(Usage::RoughnessNowhere);
-        }
-        if let RoughnessSource::Constant(a) = r.base
-            && !(0.0..=1.0).contains(&a)
-        {
-            return bad(Usage::RoughnessRange(a));
-        }
-        if s.alpha_coverage.is_some() {
-            return bad(Usage::CoverageOfNormalMap);
-        }
-        // Exponents are not unorm values.
-        if let Specular::BlinnPhong(_) = r.specular {
-            let float = |kind: OutputKind| match s.out_type {
-                Some(t) => t.is_float() && kind.supports(t),
-                None => kind == OutputKind::Exr,
-            };
-            let kinds: Vec<OutputKind> = match &r.output {
-                Some((_, k)) => vec![*k],
-                None => jobs.iter().map(|j| j.kind).collect(),
-            };
-            if kinds.iter().any(|&k| !float(k)) {
-                return bad(Usage::ExponentsNeedFloat);
-            }
-        }
+        check_roughness(jobs, s, r)?;
     }
     if let Some((bf, _)) = s.compress {
         if !cfg!(feature = "encode") {
@@ -323,4 +290,140 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
         });
     }
     Ok(())
+}
+
+/// The checks of a roughness chain's settings `r`.
+fn check_roughness(jobs: &[Job], s: &Settings, r: &RoughnessSettings) -> Result<()> {
+    let bad = |u: Usage| Err(Error::Usage(u));
+    if !s.normal_map {
+        return bad(Usage::RoughnessNeedsNormalMap);
+    }
+    if jobs.len() > 1 && r.output.is_some() {
+        return bad(Usage::RoughnessOutputOfBatch);
+    }
+    if r.pack_alpha && r.output.is_some() {
+        return bad(Usage::RoughnessPackedAndWritten);
+    }
+    if !r.pack_alpha && r.output.is_none() {
+        return bad(Usage::RoughnessNowhere);
+    }
+    if let RoughnessSource::Constant(a) = r.base
+        && !(0.0..=1.0).contains(&a)
+    {
+        return bad(Usage::RoughnessRange(a));
+    }
+    if s.alpha_coverage.is_some() {
+        return bad(Usage::CoverageOfNormalMap);
+    }
+    // Exponents are not unorm values.
+    if let Specular::BlinnPhong(_) = r.specular {
+        let float = |kind: OutputKind| match s.out_type {
+            Some(t) => t.is_float() && kind.supports(t),
+            None => kind == OutputKind::Exr,
+        };
+        let kinds: Vec<OutputKind> = match &r.output {
+            Some((_, k)) => vec![*k],
+            None => jobs.iter().map(|j| j.kind).collect(),
+        };
+        if kinds.iter().any(|&k| !float(k)) {
+            return bad(Usage::ExponentsNeedFloat);
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::compress::Quality;
+
+    /// The library's words for every usage problem name no command-line
+    /// option (the CLI adds its own), and the checks return them typed.
+    #[test]
+    fn usage_problems_name_no_option() {
+        let out = PathBuf::from("a.ktx2");
+        let all = [
+            Usage::LevelsZero,
+            Usage::AlphaCoverageRange(1.5),
+            Usage::TypeNotStored {
+                ty: ChannelType::F32,
+                container: "PNG",
+            },
+            Usage::RoughnessNeedsNormalMap,
+            Usage::RoughnessOutputOfBatch,
+            Usage::RoughnessPackedAndWritten,
+            Usage::RoughnessNowhere,
+            Usage::RoughnessRange(2.0),
+            Usage::CoverageOfNormalMap,
+            Usage::ExponentsNeedFloat,
+            Usage::EncodersMissing(BlockFormat::Bc7),
+            Usage::BlocksNotStored {
+                container: "OpenEXR",
+                output: out.clone(),
+            },
+            Usage::TypeWithBlocks(ChannelType::F16),
+            Usage::BlocksWithRoughness,
+            Usage::SupercompressionLevel {
+                scheme: Supercompression::Zstd(30),
+                lo: 1,
+                hi: 22,
+            },
+            Usage::SupercompressionNotStored {
+                scheme: Supercompression::Zlib(3),
+                output: out.clone(),
+                container: "DDS",
+            },
+            Usage::ResizeNormalMap,
+            Usage::RoundingUpNotStored {
+                container: "KTX2",
+                output: out.clone(),
+            },
+            Usage::PackOverwritesAlpha,
+            Usage::ExrLevels { full: 7 },
+        ];
+        for u in &all {
+            let text = Error::Usage(u.clone()).to_string();
+            assert!(!text.contains("--"), "{text}");
+            assert!(text.starts_with("invalid option: "), "{text}");
+        }
+        let job = |name: &str| Job::new("builtin:checker:16", Path::new(name)).unwrap();
+        let up = Settings {
+            rounding: Rounding::Up,
+            ..Settings::default()
+        };
+        assert!(matches!(
+            check(&[job("a.ktx2")], &up),
+            Err(Error::Usage(Usage::RoundingUpNotStored {
+                container: "KTX2",
+                ..
+            }))
+        ));
+        let zstd = Settings {
+            supercompression: Some(Supercompression::Zstd(23)),
+            ..Settings::default()
+        };
+        assert!(matches!(
+            check(&[job("a.ktx2")], &zstd),
+            Err(Error::Usage(Usage::SupercompressionLevel {
+                lo: 1,
+                hi: 22,
+                ..
+            }))
+        ));
+        let bc7 = Settings {
+            compress: Some((BlockFormat::Bc7, Quality::default())),
+            ..Settings::default()
+        };
+        if cfg!(feature = "encode") {
+            assert!(matches!(
+                check(&[job("a.exr")], &bc7),
+                Err(Error::Usage(Usage::BlocksNotStored {
+                    container: "OpenEXR",
+                    ..
+                }))
+            ));
+        }
+    }
 }
