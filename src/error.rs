@@ -68,6 +68,11 @@ pub enum Error {
     /// combination.
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// A setting of the mip pipeline that does not fit the job or another
+    /// setting: which setting, which value, which container. Front ends
+    /// say it in their own option names.
+    #[error("invalid option: {0}")]
+    Usage(crate::pipeline::Usage),
     /// A file or directory could not be opened, read or written.
     #[error("{action}: {error}")]
     Io {

@@ -106,15 +106,15 @@ mod tests {
             Setting::NoAutoOrient
         );
         let out = respell(&text, |s| match s {
-            Setting::MaxWidth => "--max-width",
-            Setting::MaxHeight => "--max-height",
-            Setting::Subimage => "--subimage",
-            Setting::NoAutoOrient => "--no-auto-orient",
+            Setting::MaxWidth => "<max-width>",
+            Setting::MaxHeight => "<max-height>",
+            Setting::Subimage => "<subimage>",
+            Setting::NoAutoOrient => "<no-auto-orient>",
             _ => "?",
         });
         assert_eq!(
             out,
-            "raise --max-width/--max-height or --subimage N; --no-auto-orient picks"
+            "raise <max-width>/<max-height> or <subimage> N; <no-auto-orient> picks"
         );
     }
 }

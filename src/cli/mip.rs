@@ -25,8 +25,8 @@ use parvo::io::{self, Limits, OutputKind};
 use parvo::mip::roughness::{NormalChannels, Specular};
 use parvo::mip::{MipFilter, NanPolicy, Rounding};
 use parvo::pipeline::{
-    self, AlphaChoice, ColorChoice, Job, Outcome, ResizeTo, RoughnessSettings, RoughnessSource,
-    Settings, Stage, Status,
+    self, AlphaChoice, ColorChoice, Job, Note, Outcome, ResizeTo, RoughnessSettings,
+    RoughnessSource, Settings, Stage, Status, Usage,
 };
 use parvo::texel::ChannelType;
 
@@ -634,7 +634,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     }
     // Usage errors, found before any input is read.
     if let Err(e) = pipeline::check(&jobs, &settings) {
-        return usage(e.to_string());
+        return usage(super::error_text(&e));
     }
     // Report panics (bugs in parvo or a dependency) as per-file errors, not
     // as the default multi-line message.
@@ -699,7 +699,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
                     secs
                 };
                 for n in &o.notes {
-                    warn(format!("parvo: {}: {n}", job.input));
+                    warn(format!("parvo: {}: {}", job.input, note_text(n)));
                 }
                 if args.json {
                     line(json_line(job, &o, secs));
@@ -872,9 +872,113 @@ fn json_line(job: &Job, o: &Outcome, secs: f64) -> String {
                 "encode_seconds": l.encode_s,
             })).collect::<Vec<_>>(),
         })),
-        "notes": o.notes.iter().map(super::words).collect::<Vec<_>>(),
+        "notes": o.notes.iter().map(note_text).collect::<Vec<_>>(),
     })
     .to_string()
+}
+
+/// A pipeline usage problem in this command's option names.
+pub(crate) fn usage_text(u: &Usage) -> String {
+    match u {
+        Usage::LevelsZero => "--levels must be at least 1".into(),
+        Usage::AlphaCoverageRange(r) => format!("--alpha-coverage {r}: must be between 0 and 1"),
+        Usage::TypeNotStored { ty: t, container } => format!(
+            "--type {t}: {container} cannot store {t} texels (EXR: f16, f32; PNG: u8, u16; KTX2 and DDS: all)"
+        ),
+        Usage::RoughnessNeedsNormalMap => {
+            "a roughness chain is made from a normal map: add --normal-map".into()
+        }
+        Usage::RoughnessOutputOfBatch => {
+            "--roughness-out names one file: use it with -o (one input)".into()
+        }
+        Usage::RoughnessPackedAndWritten => {
+            "--pack-roughness stores the roughness in the normal output: drop --roughness-out"
+                .into()
+        }
+        Usage::RoughnessNowhere => {
+            "give --roughness-out FILE or --pack-roughness A for the roughness".into()
+        }
+        Usage::RoughnessRange(a) => format!("--roughness {a}: must be from 0 to 1"),
+        Usage::CoverageOfNormalMap => "--alpha-coverage does not apply to normal maps".into(),
+        Usage::ExponentsNeedFloat => "--specular blinn-phong writes exponents above 1: the chain \
+                                      needs a float output (.exr, or --type f16/f32 with \
+                                      .ktx2/.dds)"
+            .into(),
+        Usage::EncodersMissing(bf) => format!(
+            "--compress {}: this parvo was built without the `encode` feature (the block encoders)",
+            bf.name().to_ascii_lowercase()
+        ),
+        Usage::BlocksNotStored { container, output } => format!(
+            "--compress: {container} cannot store block-compressed texels; use .ktx2 or .dds \
+             (output {})",
+            output.display()
+        ),
+        Usage::TypeWithBlocks(t) => {
+            format!("--type {t} with --compress: the block format fixes what is stored")
+        }
+        Usage::BlocksWithRoughness => "--compress with --roughness is not supported yet: \
+                                       compress the normal and roughness chains in two runs"
+            .into(),
+        Usage::SupercompressionLevel { scheme, lo, hi } => format!(
+            "--{} {}: the level must be from {lo} to {hi}",
+            scheme.name(),
+            match scheme {
+                Supercompression::Zstd(l) | Supercompression::Zlib(l) => l,
+            }
+        ),
+        Usage::SupercompressionNotStored {
+            scheme,
+            output,
+            container,
+        } => format!(
+            "--{}: supercompression is a KTX2 feature; output {} is {container}",
+            scheme.name(),
+            output.display()
+        ),
+        Usage::ResizeNormalMap => {
+            "--resize-to with --normal-map is not supported: resize the normal map first".into()
+        }
+        Usage::RoundingUpNotStored { container, output } => format!(
+            "--rounding up: {container} defines its level sizes as floor(size / 2^k); use .exr \
+             or PNG levels for rounded-up chains (output {})",
+            output.display()
+        ),
+        Usage::PackOverwritesAlpha => "the normal map has a fourth channel; --pack-roughness \
+                                       would overwrite it (write the roughness with \
+                                       --roughness-out instead)"
+            .into(),
+        Usage::ExrLevels { full } => format!(
+            "a mip-mapped OpenEXR file holds the full chain ({full} levels); --levels applies to \
+             .ktx2, .dds and PNG"
+        ),
+        _ => u.to_string(),
+    }
+}
+
+/// A pipeline note in this command's option names.
+fn note_text(n: &Note) -> String {
+    match n {
+        Note::Resized { from, to, filter } => format!(
+            "resized {}x{} to {}x{} ({filter} filter) for --resize-to",
+            from.0, from.1, to.0, to.1
+        ),
+        Note::WebGlMisfit { level, size } => format!(
+            "level {level} is {}x{}: WebGL refuses block-compressed levels unless level 0's sides \
+             are multiples of 4 (and level k's sides times 2^k are); --resize-to multiple-of-4 \
+             makes them so",
+            size.0, size.1
+        ),
+        Note::Clipped {
+            clipped,
+            texels,
+            to,
+        } => format!(
+            "{clipped} of {texels} texels (all levels) hold values outside 0..1 and are clipped to \
+             the {to} range; keep a float output (.exr, or --type f16) to keep them"
+        ),
+        // The loader's notes, which may name settings.
+        _ => super::words(n),
+    }
 }
 
 /// Peak resident set size of this process (Linux `VmHWM`), if available.

@@ -62,6 +62,9 @@ pub(crate) fn words(text: impl std::fmt::Display) -> String {
 /// The CLI's words for a library error: the error and, where a flag
 /// deals with it, that flag.
 pub(crate) fn error_text(e: &parvo::Error) -> String {
+    if let parvo::Error::Usage(u) = e {
+        return format!("invalid option: {}", mip::usage_text(u));
+    }
     let hint = match e {
         parvo::Error::NonFinite { .. } => {
             Some("--fixnan black or --fixnan neighbors replaces such values")

@@ -48,6 +48,31 @@ pub fn levels(sizes: &[(u32, u32)], options: &MipOptions) -> usize {
         .unwrap_or(0)
 }
 
+/// One band's next level: `lr` rows of `lw` texels of linear f32 (`ch`
+/// channels, alpha-weighted by channel `straight`) reduced by the 2×2 box
+/// into `next` (resized to `lw / 2` × `lr / 2`). The level kernel of every
+/// band-by-band box build: the whole-level one here ([`box_levels`]) and
+/// the one that stores another format ([`super::band`]). True when every
+/// value came out finite.
+pub(crate) fn reduce_band(
+    prev: &[f32],
+    lw: usize,
+    lr: usize,
+    ch: usize,
+    straight: Option<usize>,
+    next: &mut Vec<f32>,
+) -> bool {
+    let nw = lw / 2;
+    next.resize(nw * (lr / 2) * ch, 0.0);
+    let mut all_finite = true;
+    for (r, o) in next.chunks_exact_mut(nw * ch).enumerate() {
+        let r0 = &prev[2 * r * lw * ch..(2 * r + 1) * lw * ch];
+        let r1 = &prev[(2 * r + 1) * lw * ch..(2 * r + 2) * lw * ch];
+        all_finite &= box_row_f32(r0, r1, o, ch, straight);
+    }
+    all_finite
+}
+
 thread_local! {
     /// A band of one level and of the next, in linear f32.
     static SCRATCH: std::cell::RefCell<(Vec<f32>, Vec<f32>)> =
@@ -107,18 +132,8 @@ pub fn box_levels(base: &Texture, m: usize, stored: Format) -> Levels {
             // Per-thread scratch that outlives the call: fresh buffers per
             // rayon job would fault in a megabyte of new pages each time.
             SCRATCH.with_borrow_mut(|(cur, next)| {
-                // One level's rows from the previous level's (`lw` wide,
-                // `lr` rows) into `next`.
                 let reduce = |prev: &[f32], lw: usize, lr: usize, next: &mut Vec<f32>| {
-                    let nw = lw / 2;
-                    next.resize(nw * (lr / 2) * ch, 0.0);
-                    let mut all_finite = true;
-                    for (r, o) in next.chunks_exact_mut(nw * ch).enumerate() {
-                        let r0 = &prev[2 * r * lw * ch..(2 * r + 1) * lw * ch];
-                        let r1 = &prev[(2 * r + 1) * lw * ch..(2 * r + 2) * lw * ch];
-                        all_finite &= box_row_f32(r0, r1, o, ch, straight);
-                    }
-                    all_finite
+                    reduce_band(prev, lw, lr, ch, straight, next)
                 };
                 // Level 1 from level 0's band, decoded (or read in place).
                 let level1_finite = match in_place {
