@@ -5,7 +5,7 @@
 //! loses no precision: the index is an `i64` and the modulo is exact.
 //! [`wrap_index`] is the single implementation every filter calls; the
 //! continuous coordinate's reduction into the first period
-//! ([`reduce_coordinate`]) and a mode's [`period`] live here too, so the
+//! (`reduce_coordinate`) and a mode's [`period`] live here too, so the
 //! samplers and the summed-area table state the rule once.
 
 use std::fmt;
