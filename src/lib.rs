@@ -22,8 +22,8 @@
 //!   straight or premultiplied alpha) and the conversions to and from
 //!   linear-light f32 that every filter works in.
 //! - [`texture`]: [`Texture`], an owned level with checked dimensions.
-//! - [`wrap`]: [`WrapMode`] and the one function mapping integer texel
-//!   indices into a level.
+//! - [`wrap`]: [`WrapMode`] and the wrap rule: the one function mapping
+//!   integer texel indices into a level, a mode's period.
 //! - [`builtin`]: procedural textures (`builtin:checker`,
 //!   `builtin:zoneplate`).
 //! - [`mip`]: level sizes, kernels, polyphase weights, the separable
@@ -38,7 +38,10 @@
 //!   from screen to texture, their per-pixel queries, raster orders,
 //!   accuracy metrics.
 //! - [`cache`]: memory layouts of a chain, the texel cache simulator with
-//!   3C miss classes and its plain reference model, scene runs.
+//!   3C miss classes and its plain reference model, scene runs, sweeps of
+//!   caches × layouts × filters.
+//! - [`tradeoff`]: the trade-off report (each filter's speed, traffic,
+//!   accuracy and flicker on a scene) as data.
 //! - [`compress`]: GPU block formats (BC1–BC7) and their decoding.
 //! - `io` (feature `io`): file formats: loading PNG, JPEG, TIFF, HDR,
 //!   OpenEXR, KTX2, DDS and built-ins with decoder limits, and atomic
@@ -91,6 +94,7 @@ pub mod shade;
 pub mod store;
 pub mod texel;
 pub mod texture;
+pub mod tradeoff;
 pub mod wrap;
 
 pub use error::{Error, Result};

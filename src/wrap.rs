@@ -3,7 +3,10 @@
 //! All wrapping is done on integer texel indices (after the floor of the
 //! continuous coordinate), so a coordinate such as u = 1e6 under `repeat`
 //! loses no precision: the index is an `i64` and the modulo is exact.
-//! [`wrap_index`] is the single implementation every filter calls.
+//! [`wrap_index`] is the single implementation every filter calls; the
+//! continuous coordinate's reduction into the first period
+//! (`reduce_coordinate`) and a mode's [`period`] live here too, so the
+//! samplers and the summed-area table state the rule once.
 
 use std::fmt;
 use std::str::FromStr;
@@ -169,6 +172,52 @@ pub fn floor_index(x: f64) -> i64 {
     x.floor().clamp(-LIM, LIM) as i64
 }
 
+/// Texels in one period of `mode` on an axis of `size ≥ 1` texels: `size`
+/// for `repeat`, `2 · size` for `mirror` (a tile and its mirror image),
+/// `None` for the modes that do not repeat. Index `i` and `i + k · period`
+/// read the same texel; the summed-area table splits a position into
+/// whole periods and a rest with it.
+#[inline]
+pub fn period(mode: WrapMode, size: i64) -> Option<i64> {
+    match mode {
+        WrapMode::Repeat => Some(size),
+        WrapMode::MirroredRepeat => Some(2 * size),
+        _ => None,
+    }
+}
+
+/// Below this magnitude the truncating cast gives the floor directly.
+pub(crate) const FAST: f64 = 4_503_599_627_370_496.0; // 2^52
+
+/// `floor(x)` as an index, saturating like [`floor_index`] (NaN → 0).
+///
+/// `f64::floor` is a library call on the x86-64 baseline (no SSE4.1
+/// `roundsd`); a truncating cast and a compare are a few cycles.
+#[inline(always)]
+pub(crate) fn fast_floor(x: f64) -> i64 {
+    if x.abs() < FAST {
+        let i = x as i64;
+        i - i64::from((i as f64) > x)
+    } else {
+        floor_index(x)
+    }
+}
+
+/// A normalised coordinate moved into the first period of `repeat`
+/// (period 1) or `mirror` (period 2), exactly (`x − floor(x)` has no
+/// rounding in `f64`), so every level's texel index moves by a whole
+/// number of periods and [`wrap_index`] maps it to the same texel; NaN
+/// reads as 0, infinities and the other modes pass through.
+#[inline(always)]
+pub(crate) fn reduce_coordinate(x: f64, mode: WrapMode) -> f64 {
+    let x = if x.is_nan() { 0.0 } else { x };
+    match mode {
+        WrapMode::Repeat if x.is_finite() => x - fast_floor(x) as f64,
+        WrapMode::MirroredRepeat if x.is_finite() => x - 2.0 * fast_floor(0.5 * x) as f64,
+        _ => x,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,6 +250,26 @@ mod tests {
         assert_eq!(wrap_index(WrapMode::MirroredRepeat, -1, 4), Some(0));
         assert_eq!(wrap_index(WrapMode::MirroredRepeat, 4, 4), Some(3));
         assert_eq!(wrap_index(WrapMode::MirroredRepeat, 8, 4), Some(0));
+    }
+
+    /// A period moves no index: `i` and `i + k · period` read the same
+    /// texel, and the modes without a period have none.
+    #[test]
+    fn a_period_maps_to_the_same_texel() {
+        for mode in WrapMode::ALL {
+            for size in [1i64, 2, 3, 7, 16] {
+                let Some(p) = period(mode, size) else {
+                    assert!(!matches!(mode, WrapMode::Repeat | WrapMode::MirroredRepeat));
+                    continue;
+                };
+                for i in -50..50 {
+                    for k in [-3i64, -1, 1, 5] {
+                        let a = wrap_index(mode, i, size as u32);
+                        assert_eq!(a, wrap_index(mode, i + k * p, size as u32), "{mode} {i}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

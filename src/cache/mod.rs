@@ -8,12 +8,14 @@
 //! texel it reads to a [`crate::sample::TexelSink`]; [`run::AddressSink`] maps
 //! (level, x, y) to a byte address with a [`layout::ChainLayout`] and feeds
 //! the [`sim::Simulator`] (or records the addresses as a trace); [`run`]
-//! drives a whole frame.
+//! drives a whole frame, [`sweep`] one frame under a grid of caches,
+//! layouts and filters.
 
 pub mod layout;
 pub mod reference;
 pub mod run;
 pub mod sim;
+pub mod sweep;
 
 pub use layout::{ChainLayout, Layout};
 pub use sim::{AddressSpace, CacheConfig, Counters, Outcome, Policy, Simulator, Stats};

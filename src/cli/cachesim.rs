@@ -18,11 +18,11 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow, bail};
 use indicatif::ProgressBar;
-use rayon::prelude::*;
 
 use parvo::cache::layout::{ChainLayout, Layout};
 use parvo::cache::run::{RunStats, SceneSetup, read_trace, unpack, write_trace_line};
 use parvo::cache::sim::{AddressSpace, CacheConfig, Counters, Simulator, parse_size};
+use parvo::cache::sweep::{SweepRow, SweepSettings, cache_grid, sweep};
 use parvo::sample::{MipMode, Sampler, SamplerOptions};
 use parvo::scene::{Frame, RasterOrder, Scene};
 
@@ -229,28 +229,7 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         b.finish_and_clear();
     }
     let report = Report {
-        what: format!(
-            "scene {} {}, texture {} ({}, {} levels), filter {}, layout {}, order {}",
-            args.scene,
-            args.size,
-            args.texture,
-            match blocks {
-                Some(b) => format!(
-                    "{b} blocks, {} bytes per 4x4 block (a texel read fetches its block; the \
-                     layout counts blocks)",
-                    layout.texel()
-                ),
-                None => format!(
-                    "{}, {} bytes per texel",
-                    chain.levels()[0].format(),
-                    layout.texel()
-                ),
-            },
-            chain.len(),
-            sampler.options().name(),
-            args.layout,
-            args.order
-        ),
+        what: scene_what(&args, &chain, blocks, &sampler, &layout),
         l1,
         l2,
         run: stats,
@@ -262,6 +241,38 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         print!("{}", report.table());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What a scene run measured, the report's first line.
+fn scene_what(
+    args: &CachesimArgs,
+    chain: &parvo::MipChain,
+    blocks: Option<parvo::compress::BlockFormat>,
+    sampler: &Sampler,
+    layout: &ChainLayout,
+) -> String {
+    format!(
+        "scene {} {}, texture {} ({}, {} levels), filter {}, layout {}, order {}",
+        args.scene,
+        args.size,
+        args.texture,
+        match blocks {
+            Some(b) => format!(
+                "{b} blocks, {} bytes per 4x4 block (a texel read fetches its block; the \
+                 layout counts blocks)",
+                layout.texel()
+            ),
+            None => format!(
+                "{}, {} bytes per texel",
+                chain.levels()[0].format(),
+                layout.texel()
+            ),
+        },
+        chain.len(),
+        sampler.options().name(),
+        args.layout,
+        args.order
+    )
 }
 
 fn sampler_options(args: &CachesimArgs, name: &str) -> Result<SamplerOptions> {
@@ -485,12 +496,31 @@ fn human(b: u64) -> String {
     }
 }
 
-/// One row of a sweep.
-struct Row {
-    filter: String,
-    layout: Layout,
-    cache: CacheConfig,
-    run: RunStats,
+/// The sweep's settings from the arguments, or the usage error.
+fn sweep_settings(args: &CachesimArgs) -> std::result::Result<SweepSettings, String> {
+    let mut sizes = Vec::new();
+    for size in &args.cache_sizes {
+        sizes.push(parse_size(size).map_err(|e| format!("--cache-sizes: {e}"))?);
+    }
+    let caches = cache_grid(&sizes, &args.lines, &args.ways, args.seed, args.sector);
+    if caches.is_empty() {
+        return Err(
+            "no valid cache in the sweep (each size must be a multiple of line × ways)".into(),
+        );
+    }
+    let mut filters = Vec::new();
+    for f in &args.filters {
+        let o = sampler_options(args, f).map_err(|e| format!("--filters: {e:#}"))?;
+        filters.push((f.clone(), o));
+    }
+    Ok(SweepSettings {
+        scene: args.scene,
+        frame: args.size,
+        order: args.order,
+        filters,
+        layouts: args.layouts.clone(),
+        caches,
+    })
 }
 
 fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
@@ -498,87 +528,25 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
         eprintln!("parvo: --sweep needs --out DIR");
         return Ok(ExitCode::from(2));
     };
-    let mut caches = Vec::new();
-    for size in &args.cache_sizes {
-        let size = match parse_size(size) {
-            Ok(s) => s,
-            Err(e) => {
-                eprintln!("parvo: --cache-sizes: {e}");
-                return Ok(ExitCode::from(2));
-            }
-        };
-        for &line in &args.lines {
-            for &ways in &args.ways {
-                let mut c = CacheConfig::new(size, line, ways);
-                c.seed = args.seed;
-                c.sector = args.sector;
-                // Skip the combinations a cache of this size cannot have
-                // (more ways than lines, or no whole sets).
-                if c.validate().is_ok() {
-                    caches.push(c);
-                }
-            }
+    let settings = match sweep_settings(args) {
+        Ok(s) => s,
+        Err(m) => {
+            eprintln!("parvo: {m}");
+            return Ok(ExitCode::from(2));
         }
-    }
-    if caches.is_empty() {
-        eprintln!(
-            "parvo: no valid cache in the sweep (each size must be a multiple of line × ways)"
-        );
-        return Ok(ExitCode::from(2));
-    }
-    let mut filters = Vec::new();
-    for f in &args.filters {
-        match sampler_options(args, f) {
-            Ok(o) => filters.push((f.clone(), o)),
-            Err(e) => {
-                eprintln!("parvo: --filters: {e:#}");
-                return Ok(ExitCode::from(2));
-            }
-        }
-    }
+    };
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let (chain, blocks) = args.read.load_chain(&args.texture)?;
-    let total = (filters.len() * args.layouts.len() * caches.len()) as u64;
     let bar = progress_bar(args)?;
     if let Some(b) = &bar {
-        b.set_length(total);
+        b.set_length(settings.configurations() as u64);
         b.set_message("configurations");
     }
-    let mut rows: Vec<Row> = Vec::with_capacity(total as usize);
-    for (name, options) in &filters {
-        let sampler = Sampler::new(&chain, *options)?;
-        for &layout in &args.layouts {
-            let cl = ChainLayout::for_sampler_stored(&chain, &sampler, layout, blocks);
-            let setup = SceneSetup {
-                sampler: &sampler,
-                layout: &cl,
-                scene: args.scene,
-                frame: args.size,
-                order: args.order,
-            };
-            let trace = setup.record();
-            let space = AddressSpace::Bounded(cl.total_bytes());
-            let levels = chain.len() as u32;
-            let runs: Vec<Result<Row>> = caches
-                .par_iter()
-                .map(|c| {
-                    let run = trace.simulate(c, None, space, levels)?;
-                    if let Some(b) = &bar {
-                        b.inc(1);
-                    }
-                    Ok(Row {
-                        filter: name.clone(),
-                        layout,
-                        cache: *c,
-                        run,
-                    })
-                })
-                .collect();
-            for r in runs {
-                rows.push(r?);
-            }
+    let rows = sweep(&chain, blocks, &settings, &|| {
+        if let Some(b) = &bar {
+            b.inc(1);
         }
-    }
+    })?;
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -589,9 +557,9 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
     println!(
         "{} configurations ({} filters × {} layouts × {} caches) of scene {} {} on {}: {} and {}",
         rows.len(),
-        filters.len(),
-        args.layouts.len(),
-        caches.len(),
+        settings.filters.len(),
+        settings.layouts.len(),
+        settings.caches.len(),
         args.scene,
         args.size,
         args.texture,
@@ -601,7 +569,7 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
+fn write_csv(path: &Path, rows: &[SweepRow]) -> Result<()> {
     parvo::io::atomic::write(path, |w| {
         let io = |e: std::io::Error| parvo::Error::Encode {
             format: "CSV",
@@ -648,7 +616,7 @@ fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
 /// Hit rate (top) and bytes per pixel (bottom) against cache size, one
 /// line per layout, one column per filter, for the sweep's middle line
 /// size and associativity.
-fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
+fn plot(path: &Path, rows: &[SweepRow], args: &CachesimArgs) -> Result<()> {
     use plotters::prelude::*;
     let pick = |v: &[u64], want: u64| {
         if v.contains(&want) {
@@ -668,7 +636,7 @@ fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
         }
         f
     };
-    let sel: Vec<&Row> = rows
+    let sel: Vec<&SweepRow> = rows
         .iter()
         .filter(|r| r.cache.line == line && r.cache.ways == ways)
         .collect();
@@ -680,14 +648,10 @@ fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
     });
     // Each panel gets its own range, so small differences stay visible.
     let range = |f: &str, top: bool| {
-        let ys = sel.iter().filter(|r| r.filter == f).map(|r| {
-            let c = &r.run.stats.total;
-            if top {
-                c.hit_rate()
-            } else {
-                c.bytes_fetched as f64 / r.run.pixels.max(1) as f64
-            }
-        });
+        let ys = sel
+            .iter()
+            .filter(|r| r.filter == f)
+            .map(|r| y_value(r, top));
         if top {
             let lo = ys.fold(1.0, f64::min);
             ((lo * 20.0).floor() / 20.0).min(0.95)..1.0
@@ -710,7 +674,6 @@ fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
             )
             .map_err(|e| anyhow!("{e}"))?;
         let cols = root.split_evenly((2, filters.len()));
-        let colours = [&BLUE, &RED, &GREEN, &MAGENTA, &BLACK, &CYAN];
         let kib = |b: u64| b as f64 / 1024.0;
         for (fi, f) in filters.iter().enumerate() {
             for (panel, top) in [(fi, true), (filters.len() + fi, false)] {
@@ -730,31 +693,7 @@ fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
                     .y_desc(ylabel)
                     .draw()
                     .map_err(|e| anyhow!("{e}"))?;
-                for (li, layout) in args.layouts.iter().enumerate() {
-                    let mut pts: Vec<(f64, f64)> = sel
-                        .iter()
-                        .filter(|r| &r.filter == f && &r.layout == layout)
-                        .map(|r| {
-                            let c = &r.run.stats.total;
-                            let y = if top {
-                                c.hit_rate()
-                            } else {
-                                c.bytes_fetched as f64 / r.run.pixels.max(1) as f64
-                            };
-                            (kib(r.cache.size), y)
-                        })
-                        .collect();
-                    pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-                    let colour = colours[li % colours.len()];
-                    chart
-                        .draw_series(LineSeries::new(pts.clone(), colour))
-                        .map_err(|e| anyhow!("{e}"))?
-                        .label(layout.to_string())
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour));
-                    chart
-                        .draw_series(pts.iter().map(|&p| Circle::new(p, 2, colour.filled())))
-                        .map_err(|e| anyhow!("{e}"))?;
-                }
+                draw_layouts(&mut chart, &sel, f, top, &args.layouts)?;
                 chart
                     .configure_series_labels()
                     .background_style(WHITE.mix(0.8))
@@ -771,4 +710,56 @@ fn plot(path: &Path, rows: &[Row], args: &CachesimArgs) -> Result<()> {
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
     super::images::write_text(path, "SVG", &svg)
+}
+
+/// A sweep row's value in the plot: the hit rate (top panels) or the
+/// bytes from memory per pixel (bottom).
+fn y_value(r: &SweepRow, top: bool) -> f64 {
+    let c = &r.run.stats.total;
+    if top {
+        c.hit_rate()
+    } else {
+        c.bytes_fetched as f64 / r.run.pixels.max(1) as f64
+    }
+}
+
+/// A panel's chart: cache size in KiB (log) against the value.
+type Chart<'a, 'b> = plotters::chart::ChartContext<
+    'a,
+    plotters::backend::SVGBackend<'b>,
+    plotters::coord::cartesian::Cartesian2d<
+        plotters::coord::combinators::LogCoord<f64>,
+        plotters::coord::types::RangedCoordf64,
+    >,
+>;
+
+/// One line per layout of filter `f`'s rows in `sel`, against cache size.
+fn draw_layouts(
+    chart: &mut Chart<'_, '_>,
+    sel: &[&SweepRow],
+    f: &str,
+    top: bool,
+    layouts: &[Layout],
+) -> Result<()> {
+    use plotters::prelude::*;
+    let colours = [&BLUE, &RED, &GREEN, &MAGENTA, &BLACK, &CYAN];
+    let kib = |b: u64| b as f64 / 1024.0;
+    for (li, layout) in layouts.iter().enumerate() {
+        let mut pts: Vec<(f64, f64)> = sel
+            .iter()
+            .filter(|r| r.filter == f && &r.layout == layout)
+            .map(|r| (kib(r.cache.size), y_value(r, top)))
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let colour = colours[li % colours.len()];
+        chart
+            .draw_series(LineSeries::new(pts.clone(), colour))
+            .map_err(|e| anyhow!("{e}"))?
+            .label(layout.to_string())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour));
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 2, colour.filled())))
+            .map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(())
 }

@@ -82,24 +82,6 @@ pub fn write_error_map(
     write_rgb(path, frame, &px)
 }
 
-/// The error-map scale: the 99th percentile of the per-pixel absolute
-/// error (so a few outliers do not wash the map out), at least 1e-4.
-pub fn error_scale(img: &[Option<[f32; 4]>], reference: &[Option<[f32; 4]>]) -> f64 {
-    let mut e: Vec<f64> = img
-        .iter()
-        .zip(reference)
-        .filter_map(|(a, r)| {
-            let (a, r) = (a.as_ref()?, r.as_ref()?);
-            Some((0..3).map(|c| (a[c] - r[c]).abs() as f64).sum::<f64>() / 3.0)
-        })
-        .collect();
-    if e.is_empty() {
-        return 1.0;
-    }
-    e.sort_by(f64::total_cmp);
-    e[(e.len() * 99 / 100).min(e.len() - 1)].max(1e-4)
-}
-
 /// Writes `text` to `path` atomically (a temporary file renamed into
 /// place); `format` names the file type in the error.
 pub fn write_text(path: &Path, format: &'static str, text: &str) -> Result<()> {

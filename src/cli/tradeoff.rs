@@ -13,30 +13,25 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow};
 use indicatif::ProgressBar;
 
-use parvo::cache::layout::{ChainLayout, Layout};
-use parvo::cache::run::SceneSetup;
-use parvo::cache::sim::CacheConfig;
 use parvo::compress::{BlockFormat, Quality};
-use parvo::sample::{Query, Sampler, SamplerOptions, TexelSink};
-use parvo::scene::metrics::{flicker, scores};
+use parvo::sample::SamplerOptions;
 use parvo::scene::reference::{PixelFilter, Reference};
-use parvo::scene::render::{ns_per_query, queries, render, show_levels};
-use parvo::scene::{Frame, RasterOrder, Scene};
+use parvo::scene::render::show_levels;
+use parvo::scene::{Frame, Scene};
 use parvo::store::TextureStore;
+use parvo::tradeoff::{self, FLICKER_SHIFT, Progress, Rendered, Report, Row, Settings};
 
-use super::images::{error_scale, write_error_map, write_image, write_rgb, write_text};
+use super::images::{write_error_map, write_image, write_rgb, write_text};
 
-/// The cache the traffic figures use (stated in the output).
-const CACHE: &str = "16K:64:4";
-const LAYOUT: &str = "tiled:4x4";
-const ORDER: &str = "tiled:8";
-/// The camera move between the flicker frames, pixels.
-const FLICKER_SHIFT: (f64, f64) = (0.25, 0.0);
+/// The cache, layout and order the traffic figures use (stated in the
+/// output).
+const CACHE: &str = tradeoff::DEFAULT_CACHE;
+const LAYOUT: &str = tradeoff::DEFAULT_LAYOUT;
+const ORDER: &str = tradeoff::DEFAULT_ORDER;
 
 /// Arguments of `parvo tradeoff`.
 #[derive(clap::Args, Debug)]
@@ -109,158 +104,6 @@ pub struct TradeoffArgs {
     quality: super::mip::QualityArg,
 }
 
-/// One filter's row of the report.
-struct Row {
-    name: String,
-    /// What the chain stores: its texel format, or the block format.
-    stored: String,
-    ns_per_pixel: f64,
-    texels_per_pixel: f64,
-    bytes_per_pixel: f64,
-    psnr_db: f64,
-    rmse: f64,
-    max_error: f64,
-    flicker: f64,
-    error_scale: f64,
-    working_set: Vec<serde_json::Value>,
-}
-
-/// Marks the 64×64 tiles of each level a run reads.
-struct TileSink {
-    sizes: Vec<(u32, u32)>,
-    tiles: Vec<Vec<bool>>,
-}
-
-impl TileSink {
-    fn new(sampler: &Sampler) -> Self {
-        let n = sampler.chain().len();
-        let sizes: Vec<(u32, u32)> = (0..n)
-            .map(|k| sampler.chain().level_size(k).unwrap_or((1, 1)))
-            .collect();
-        let tiles = sizes
-            .iter()
-            .map(|&(w, h)| vec![false; (w.div_ceil(64) * h.div_ceil(64)) as usize])
-            .collect();
-        TileSink { sizes, tiles }
-    }
-}
-
-impl TexelSink for TileSink {
-    #[inline]
-    fn texel(&mut self, level: u32, x: u32, y: u32) {
-        let k = level as usize;
-        let w = self.sizes[k].0.div_ceil(64);
-        self.tiles[k][((y / 64) * w + x / 64) as usize] = true;
-    }
-}
-
-/// What every row's measurement shares.
-struct RowEnv<'a> {
-    scene: Scene,
-    frame: Frame,
-    out: &'a Path,
-    ref0: &'a parvo::scene::metrics::Pixels,
-    ref1: &'a parvo::scene::metrics::Pixels,
-    q0: &'a [Option<Query>],
-    q1: &'a [Option<Query>],
-    dense: &'a [Query],
-    cache: &'a CacheConfig,
-    order: RasterOrder,
-}
-
-impl RowEnv<'_> {
-    /// Render, score, simulate and write the images of one filter.
-    fn row(
-        &self,
-        name: String,
-        stored: String,
-        sampler: &Sampler,
-        cl: &ChainLayout,
-        ns: f64,
-    ) -> Result<Row> {
-        let img0 = render(sampler, self.q0);
-        let img1 = render(sampler, self.q1);
-        let sc = scores(self.ref0, &img0);
-        let fl = flicker((&img0, &img1), (self.ref0, self.ref1));
-        let setup = SceneSetup {
-            sampler,
-            layout: cl,
-            scene: self.scene,
-            frame: self.frame,
-            order: self.order,
-        };
-        let run = setup.simulate(self.cache, None, &mut |_| Ok(()), &|_, _| {})?;
-        let mut tiles = TileSink::new(sampler);
-        let mut out = vec![[0f32; 4]; self.dense.len()];
-        sampler.sample_slice_traced(self.dense, &mut out, &mut tiles)?;
-        let working_set = tiles
-            .tiles
-            .iter()
-            .enumerate()
-            .map(|(k, t)| {
-                let touched = t.iter().filter(|&&b| b).count();
-                serde_json::json!({
-                    "level": k,
-                    "touched": touched > 0,
-                    "tiles_touched": touched,
-                    "tiles": t.len(),
-                    "fraction": touched as f64 / t.len().max(1) as f64,
-                })
-            })
-            .collect();
-        let scale = error_scale(&img0, self.ref0);
-        let frame = self.frame;
-        write_image(&self.out.join(format!("{name}.png")), frame, &img0)?;
-        write_error_map(
-            &self.out.join(format!("{name}-error.png")),
-            frame,
-            &img0,
-            self.ref0,
-            scale,
-        )?;
-        if name == "trilinear" || name == "aniso16" {
-            let tint = show_levels(sampler, self.q0, &img0);
-            write_rgb(&self.out.join(format!("{name}-levels.png")), frame, &tint)?;
-        }
-        Ok(Row {
-            name,
-            stored,
-            ns_per_pixel: ns,
-            texels_per_pixel: run.reads as f64 / run.pixels.max(1) as f64,
-            bytes_per_pixel: run.stats.bytes_from_memory() as f64 / run.pixels.max(1) as f64,
-            psnr_db: sc.psnr_db,
-            rmse: sc.rmse,
-            max_error: sc.max_error,
-            flicker: fl,
-            error_scale: scale,
-            working_set,
-        })
-    }
-}
-
-/// The store's full chain block-compressed and decoded again, and the
-/// stored format's name.
-fn compressed_chain(
-    store: &TextureStore,
-    bf: BlockFormat,
-    quality: Quality,
-) -> Result<(Vec<parvo::texture::Texture>, String)> {
-    #[cfg(feature = "encode")]
-    {
-        let levels = store.chain()?.levels();
-        let (decoded, _) = parvo::compress::round_trip(levels, bf, quality)?;
-        let srgb = decoded[0].format().color_space == parvo::texel::ColorSpace::Srgb;
-        Ok((decoded, format!("{bf}{}", if srgb { "_SRGB" } else { "" })))
-    }
-    #[cfg(not(feature = "encode"))]
-    {
-        let _ = (store, quality);
-        Err(anyhow!(
-            "{bf}: this parvo was built without the `encode` feature"
-        ))
-    }
-}
-
 fn machine() -> serde_json::Value {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -288,144 +131,136 @@ fn machine() -> serde_json::Value {
     })
 }
 
-pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
-    let usage = |m: String| {
-        eprintln!("parvo: {m}");
-        Ok(ExitCode::from(2))
-    };
+/// The report's settings from the arguments, or the usage error.
+fn settings(args: &TradeoffArgs) -> std::result::Result<Settings, String> {
     let mut filters = Vec::new();
     for f in &args.filters {
         match SamplerOptions::from_name(f) {
-            Ok(o) => filters.push((o.name(), o)),
-            Err(e) => return usage(format!("--filters: {e}")),
+            Ok(o) => filters.push(o),
+            Err(e) => return Err(format!("--filters: {e}")),
         }
     }
     if filters.is_empty() {
-        return usage("--filters: name at least one filter".into());
+        return Err("--filters: name at least one filter".into());
     }
     if args.runs == 0 {
-        return usage("--runs must be at least 1".into());
+        return Err("--runs must be at least 1".into());
     }
     let mut reference = Reference::new(args.pixel_filter);
     if let Some(s) = args.spp {
         if !(s > 0.0 && s <= 64.0) {
-            return usage(format!("--spp {s}: must be above 0 and at most 64"));
+            return Err(format!("--spp {s}: must be above 0 and at most 64"));
         }
         reference.samples_per_texel = s;
     }
-    let store = TextureStore::from_loaded(args.read.load(&args.texture)?);
-    let wrap = store.options().wrap;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create {}", args.out.display()))?;
-    let base = store.base();
-    let tex = (base.width(), base.height());
-    let frame = args.size;
-    let tty = std::io::stderr().is_terminal();
-    let bar = if tty {
-        let b = ProgressBar::new(frame.height as u64 * 2 + filters.len() as u64);
-        b.set_style(super::bar_style(super::BAR_COUNT)?);
-        Some(b)
-    } else {
-        None
-    };
-    let step = |msg: &str| {
-        if let Some(b) = &bar {
-            b.set_message(msg.to_string());
-        }
-    };
-
-    // The reference, twice (the flicker frames).
-    step("reference");
-    let ref_sampler = store.reference_sampler(wrap)?;
-    let t0 = Instant::now();
-    let tick = |_| {
-        if let Some(b) = &bar {
-            b.inc(1);
-        }
-    };
-    let ref0 = reference.render(&args.scene, frame, (0.0, 0.0), &ref_sampler, &tick);
-    let ref_secs = t0.elapsed().as_secs_f64();
-    let ref1 = reference.render(&args.scene, frame, FLICKER_SHIFT, &ref_sampler, &tick);
-    write_image(&args.out.join("reference.png"), frame, &ref0)?;
-    let q0 = queries(&args.scene, frame, tex, (0.0, 0.0));
-    let q1 = queries(&args.scene, frame, tex, FLICKER_SHIFT);
-    let dense: Vec<Query> = q0.iter().flatten().copied().collect();
-    if dense.is_empty() {
-        anyhow::bail!("scene {} shows no texture in a {frame} frame", args.scene);
-    }
-    let cache: CacheConfig = CACHE.parse()?;
-    let layout: Layout = LAYOUT.parse()?;
-    let order: RasterOrder = ORDER.parse()?;
-
     if args.compress.is_some() && !cfg!(feature = "encode") {
-        return usage("--compress: this parvo was built without the `encode` feature".into());
+        return Err("--compress: this parvo was built without the `encode` feature".into());
     }
-    let mut samplers = Vec::new();
-    for (_, options) in &mut filters {
-        options.wrap = wrap;
-        samplers.push(store.sampler(*options)?);
-    }
-    step("timing");
-    let timings = ns_per_query(&samplers.iter().collect::<Vec<_>>(), &dense, args.runs);
-    let mut rows = Vec::new();
-    let env = RowEnv {
-        scene: args.scene,
-        frame,
-        out: &args.out,
-        ref0: &ref0,
-        ref1: &ref1,
-        q0: &q0,
-        q1: &q1,
-        dense: &dense,
-        cache: &cache,
-        order,
-    };
-    let stored = match store.stored_blocks() {
-        Some(b) => b.name().to_string(),
-        None => base.format().to_string(),
-    };
-    for ((name, options), (sampler, ns)) in filters.iter().zip(samplers.iter().zip(&timings)) {
-        step(name);
-        let chain = store.chain_for(options)?;
-        let cl = ChainLayout::for_sampler_stored(chain, sampler, layout, store.stored_blocks());
-        rows.push(env.row(name.clone(), stored.clone(), sampler, &cl, *ns)?);
-        if let Some(b) = &bar {
-            b.inc(1);
-        }
-    }
-    if let Some(c) = args.compress {
-        let bf: BlockFormat = c.into();
+    let mut settings = Settings::new(args.scene, args.size, filters).map_err(|e| e.to_string())?;
+    settings.reference = reference;
+    settings.runs = args.runs;
+    settings.cache = CACHE.parse().map_err(|e: parvo::Error| e.to_string())?;
+    settings.layout = LAYOUT.parse().map_err(|e: parvo::Error| e.to_string())?;
+    settings.order = ORDER.parse().map_err(|e: parvo::Error| e.to_string())?;
+    settings.flicker_shift = FLICKER_SHIFT;
+    settings.compress = args.compress.map(|c| {
         let quality = match args.quality {
             super::mip::QualityArg::Fast => Quality::Fast,
             super::mip::QualityArg::Normal => Quality::Normal,
             super::mip::QualityArg::Slow => Quality::Slow,
         };
-        step(&format!("{} encode", bf));
-        let (decoded, stored) = compressed_chain(&store, bf, quality)?;
-        let cstore = TextureStore::from_levels(decoded, *store.options());
-        let tag = bf.name().to_ascii_lowercase().replace("_uf16", "");
-        let mut csamplers = Vec::new();
-        for (_, options) in &filters {
-            csamplers.push(cstore.sampler(*options)?);
-        }
-        let ctimings = ns_per_query(&csamplers.iter().collect::<Vec<_>>(), &dense, args.runs);
-        for ((name, options), (sampler, ns)) in filters.iter().zip(csamplers.iter().zip(&ctimings))
-        {
-            let name = format!("{name}+{tag}");
-            step(&name);
-            let chain = cstore.chain_for(options)?;
-            let cl = ChainLayout::for_sampler_stored(chain, sampler, layout, Some(bf));
-            rows.push(env.row(name, stored.clone(), sampler, &cl, *ns)?);
+        (BlockFormat::from(c), quality)
+    });
+    Ok(settings)
+}
+
+/// Save one image of the report into `out`: the reference, or a row's
+/// frame, its error map and (trilinear, aniso16) its level tint.
+fn save(out: &Path, frame: Frame, image: Rendered<'_>) -> Result<()> {
+    match image {
+        Rendered::Reference(img) => write_image(&out.join("reference.png"), frame, img),
+        Rendered::Filter {
+            row,
+            image,
+            reference,
+            sampler,
+            queries,
+        } => {
+            let name = &row.name;
+            write_image(&out.join(format!("{name}.png")), frame, image)?;
+            write_error_map(
+                &out.join(format!("{name}-error.png")),
+                frame,
+                image,
+                reference,
+                row.error_scale,
+            )?;
+            if name == "trilinear" || name == "aniso16" {
+                let tint = show_levels(sampler, queries, image);
+                write_rgb(&out.join(format!("{name}-levels.png")), frame, &tint)?;
+            }
+            Ok(())
         }
     }
+}
+
+pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
+    let settings = match settings(&args) {
+        Ok(s) => s,
+        Err(m) => {
+            eprintln!("parvo: {m}");
+            return Ok(ExitCode::from(2));
+        }
+    };
+    let store = TextureStore::from_loaded(args.read.load(&args.texture)?);
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let bar = if std::io::stderr().is_terminal() {
+        let b = ProgressBar::new(tradeoff::progress_total(&settings));
+        b.set_style(super::bar_style(super::BAR_COUNT)?);
+        Some(b)
+    } else {
+        None
+    };
+    let progress = |p: Progress<'_>| {
+        if let Some(b) = &bar {
+            match p {
+                Progress::Step(msg) => b.set_message(msg.to_string()),
+                Progress::Advance => b.inc(1),
+            }
+        }
+    };
+    let report = tradeoff::run(&store, &settings, &progress, &mut |image| {
+        save(&args.out, args.size, image)
+    })?;
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let built = store.built();
-    let report = serde_json::json!({
+    let json_path = args.out.join("report.json");
+    let text = serde_json::to_string_pretty(&report_json(&args, &settings, &report))
+        .context("cannot format report.json")?;
+    write_text(&json_path, "JSON", &text)?;
+    let svg = args.out.join("tradeoff.svg");
+    plot(&svg, &report.rows, &args)?;
+    print_table(&args, &report);
+    println!(
+        "wrote {}, {} and the images in {}",
+        json_path.display(),
+        svg.display(),
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `report.json`.
+fn report_json(args: &TradeoffArgs, settings: &Settings, report: &Report) -> serde_json::Value {
+    let reference = &settings.reference;
+    let built = &report.built;
+    let tex = report.texture_size;
+    serde_json::json!({
         "scene": args.scene.to_string(),
-        "frame": frame.to_string(),
-        "pixels": dense.len(),
+        "frame": args.size.to_string(),
+        "pixels": report.pixels,
         "texture": args.texture,
         "texture_size": [tex.0, tex.1],
         "pixel_filter": args.pixel_filter.to_string(),
@@ -433,7 +268,7 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
             "samples_per_texel": reference.samples_per_texel,
             "min_samples": reference.min_samples,
             "max_samples": reference.max_samples,
-            "seconds": ref_secs,
+            "seconds": report.reference_seconds,
         },
         "cache": {"cache": CACHE, "layout": LAYOUT, "order": ORDER},
         "flicker_shift_pixels": [FLICKER_SHIFT.0, FLICKER_SHIFT.1],
@@ -444,7 +279,7 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
             "sat": built.sat,
             "sat_bytes": built.sat_bytes,
         },
-        "filters": rows.iter().map(|r| serde_json::json!({
+        "filters": report.rows.iter().map(|r| serde_json::json!({
             "name": r.name,
             "stored": r.stored,
             "ns_per_pixel": r.ns_per_pixel,
@@ -455,24 +290,30 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
             "max_error": r.max_error,
             "flicker": r.flicker,
             "error_map_scale": r.error_scale,
-            "working_set": r.working_set,
+            "working_set": r.working_set.iter().map(|t| serde_json::json!({
+                "level": t.level,
+                "touched": t.touched > 0,
+                "tiles_touched": t.touched,
+                "tiles": t.tiles,
+                "fraction": t.fraction(),
+            })).collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
-    });
-    let json_path = args.out.join("report.json");
-    let text = serde_json::to_string_pretty(&report).context("cannot format report.json")?;
-    write_text(&json_path, "JSON", &text)?;
-    let svg = args.out.join("tradeoff.svg");
-    plot(&svg, &rows, &args)?;
+    })
+}
 
+/// The table on stdout.
+fn print_table(args: &TradeoffArgs, report: &Report) {
+    let tex = report.texture_size;
     println!(
-        "scene {} {frame} ({} pixels), texture {} {}x{}, reference: {} pixel filter ({:.1} s per frame)",
+        "scene {} {} ({} pixels), texture {} {}x{}, reference: {} pixel filter ({:.1} s per frame)",
         args.scene,
-        dense.len(),
+        args.size,
+        report.pixels,
         args.texture,
         tex.0,
         tex.1,
         args.pixel_filter,
-        ref_secs
+        report.reference_seconds
     );
     println!(
         "speed: one thread, untraced, median of {}; traffic: cache {CACHE}, layout {LAYOUT}, order {ORDER}; flicker: camera moved 1/4 pixel",
@@ -482,7 +323,7 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
         "{:<12} {:>9} {:>9} {:>9} {:>8} {:>8} {:>8} {:>9}",
         "filter", "ns/pixel", "texels/px", "bytes/px", "PSNR dB", "RMSE", "max err", "flicker"
     );
-    for r in &rows {
+    for r in &report.rows {
         println!(
             "{:<12} {:>9.1} {:>9.2} {:>9.2} {:>8.2} {:>8.4} {:>8.4} {:>9.4}",
             r.name,
@@ -495,6 +336,7 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
             r.flicker
         );
     }
+    let built = &report.built;
     println!(
         "built: {} mip levels ({} bytes){}; error maps scaled to the 99th-percentile error (in report.json)",
         built.mip_levels,
@@ -505,13 +347,6 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
             String::new()
         }
     );
-    println!(
-        "wrote {}, {} and the images in {}",
-        json_path.display(),
-        svg.display(),
-        args.out.display()
-    );
-    Ok(ExitCode::SUCCESS)
 }
 
 /// PSNR against ns per pixel, one labelled point per filter, the Pareto
@@ -584,59 +419,17 @@ fn plot(path: &Path, rows: &[Row], args: &TradeoffArgs) -> Result<()> {
                 .map_err(|e| anyhow!("{e}"))?;
             }
         }
-        let mut front: Vec<&Row> = rows
-            .iter()
-            .filter(|r| {
-                !rows.iter().any(|o| {
-                    (o.ns_per_pixel <= r.ns_per_pixel && o.psnr_db > r.psnr_db)
-                        || (o.ns_per_pixel < r.ns_per_pixel && o.psnr_db >= r.psnr_db)
-                })
-            })
-            .collect();
-        front.sort_by(|a, b| a.ns_per_pixel.total_cmp(&b.ns_per_pixel));
         chart
             .draw_series(LineSeries::new(
-                front.iter().map(|r| (r.ns_per_pixel, r.psnr_db)),
+                pareto_front(rows)
+                    .iter()
+                    .map(|r| (r.ns_per_pixel, r.psnr_db)),
                 RED.stroke_width(2),
             ))
             .map_err(|e| anyhow!("{e}"))?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RED));
-        // Labels placed greedily where they overlap no label placed
-        // before (points close together, such as aniso4..16, would
-        // otherwise print over each other).
-        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
-        let mut order: Vec<&Row> = rows.iter().filter(|r| r.psnr_db.is_finite()).collect();
-        order.sort_by(|a, b| a.ns_per_pixel.total_cmp(&b.ns_per_pixel));
-        for r in order {
-            let p = (r.ns_per_pixel, r.psnr_db);
-            let (px, py) = chart.backend_coord(&p);
-            let w = 7 * r.name.len() as i32 + 4;
-            let candidates = [(6, 3), (6, -17), (6, 19), (6, -33), (6, 35), (6, -49)];
-            let overlaps = |(x, y): (i32, i32)| {
-                placed.iter().any(|&(a, b, c, d)| {
-                    px + x < c && a < px + x + w && py + y < d && b < py + y + 14
-                })
-            };
-            let (dx, dy) = candidates
-                .iter()
-                .copied()
-                .find(|&o| !overlaps(o))
-                .unwrap_or(candidates[0]);
-            placed.push((px + dx, py + dy, px + dx + w, py + dy + 14));
-            chart
-                .draw_series(std::iter::once(
-                    EmptyElement::at(p)
-                        + Circle::new((0, 0), 4, BLUE.filled())
-                        // A leader line where the label had to move away.
-                        + PathElement::new(
-                            if dy == 3 { vec![] } else { vec![(0, 0), (dx, dy + 7)] },
-                            BLACK.mix(0.5),
-                        )
-                        + Text::new(r.name.clone(), (dx + 2, dy), ("sans-serif", 13).into_font()),
-                ))
-                .map_err(|e| anyhow!("{e}"))?;
-        }
+        draw_points(&mut chart, rows)?;
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
@@ -647,4 +440,71 @@ fn plot(path: &Path, rows: &[Row], args: &TradeoffArgs) -> Result<()> {
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
     super::images::write_text(path, "SVG", &svg)
+}
+
+/// The rows no other row beats on both speed and accuracy (no other
+/// filter both faster and more accurate), fastest first.
+fn pareto_front(rows: &[Row]) -> Vec<&Row> {
+    let mut front: Vec<&Row> = rows
+        .iter()
+        .filter(|r| {
+            !rows.iter().any(|o| {
+                (o.ns_per_pixel <= r.ns_per_pixel && o.psnr_db > r.psnr_db)
+                    || (o.ns_per_pixel < r.ns_per_pixel && o.psnr_db >= r.psnr_db)
+            })
+        })
+        .collect();
+    front.sort_by(|a, b| a.ns_per_pixel.total_cmp(&b.ns_per_pixel));
+    front
+}
+
+/// The plot's chart: ns per pixel (log) against PSNR.
+type Chart<'a, 'b> = plotters::chart::ChartContext<
+    'a,
+    plotters::backend::SVGBackend<'b>,
+    plotters::coord::cartesian::Cartesian2d<
+        plotters::coord::combinators::LogCoord<f64>,
+        plotters::coord::types::RangedCoordf64,
+    >,
+>;
+
+/// One labelled point per row with a finite PSNR.
+fn draw_points(chart: &mut Chart<'_, '_>, rows: &[Row]) -> Result<()> {
+    use plotters::prelude::*;
+    // Labels placed greedily where they overlap no label placed
+    // before (points close together, such as aniso4..16, would
+    // otherwise print over each other).
+    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+    let mut order: Vec<&Row> = rows.iter().filter(|r| r.psnr_db.is_finite()).collect();
+    order.sort_by(|a, b| a.ns_per_pixel.total_cmp(&b.ns_per_pixel));
+    for r in order {
+        let p = (r.ns_per_pixel, r.psnr_db);
+        let (px, py) = chart.backend_coord(&p);
+        let w = 7 * r.name.len() as i32 + 4;
+        let candidates = [(6, 3), (6, -17), (6, 19), (6, -33), (6, 35), (6, -49)];
+        let overlaps = |(x, y): (i32, i32)| {
+            placed
+                .iter()
+                .any(|&(a, b, c, d)| px + x < c && a < px + x + w && py + y < d && b < py + y + 14)
+        };
+        let (dx, dy) = candidates
+            .iter()
+            .copied()
+            .find(|&o| !overlaps(o))
+            .unwrap_or(candidates[0]);
+        placed.push((px + dx, py + dy, px + dx + w, py + dy + 14));
+        chart
+            .draw_series(std::iter::once(
+                EmptyElement::at(p)
+                    + Circle::new((0, 0), 4, BLUE.filled())
+                    // A leader line where the label had to move away.
+                    + PathElement::new(
+                        if dy == 3 { vec![] } else { vec![(0, 0), (dx, dy + 7)] },
+                        BLACK.mix(0.5),
+                    )
+                    + Text::new(r.name.clone(), (dx + 2, dy), ("sans-serif", 13).into_font()),
+            ))
+            .map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(())
 }

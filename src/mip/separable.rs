@@ -344,17 +344,11 @@ fn filter_row(
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use std::arch::x86_64::*;
-    use std::sync::OnceLock;
 
     use super::AxisWeights;
 
     pub fn available() -> bool {
-        static OK: OnceLock<bool> = OnceLock::new();
-        *OK.get_or_init(|| {
-            crate::cpu::simd_allowed()
-                && is_x86_feature_detected!("avx2")
-                && is_x86_feature_detected!("fma")
-        })
+        crate::cpu::avx2_fma()
     }
 
     #[target_feature(enable = "avx2,fma")]
@@ -528,7 +522,7 @@ mod tests {
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn avx_row_kernel_matches_portable() {
-        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
+        if !crate::cpu::avx2_fma_detected() {
             return;
         }
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;

@@ -48,7 +48,7 @@ pub fn available() -> bool {
 /// `PARVO_NO_AVX` says).
 pub fn supported() -> bool {
     #[cfg(target_arch = "x86_64")]
-    return x86::detected();
+    return crate::cpu::avx512_vnni_detected();
     #[cfg(not(target_arch = "x86_64"))]
     false
 }
@@ -109,13 +109,6 @@ mod x86 {
     use std::sync::OnceLock;
 
     use super::{AMBIGUITY, FixedSrgb, LINEAR_BELOW, POLY, SHORT_FROM, row_u8_srgb_n};
-
-    pub fn detected() -> bool {
-        is_x86_feature_detected!("avx512f")
-            && is_x86_feature_detected!("avx512bw")
-            && is_x86_feature_detected!("avx512vbmi")
-            && is_x86_feature_detected!("avx512vnni")
-    }
 
     /// Byte planes of the decode table and the per-octave scales.
     pub struct Tables {

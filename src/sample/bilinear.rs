@@ -22,28 +22,10 @@
 //! ±2^62 (then wrapped like any index) and the fraction is taken as 0.
 //! NaN coordinates are replaced by 0 before they get here.
 
-use crate::wrap::{WrapMode, floor_index, wrap_index};
+use crate::wrap::{FAST, WrapMode, fast_floor, floor_index, reduce_coordinate, wrap_index};
 
 use super::fetch::{Addressing, Chain, Pixel, lerp};
-use super::footprint::reduce_f64;
 use super::trace::TexelSink;
-
-/// Below this magnitude the truncating cast gives the floor directly.
-const FAST: f64 = 4_503_599_627_370_496.0; // 2^52
-
-/// `floor(x)` as an index, saturating like [`floor_index`] (NaN → 0).
-///
-/// `f64::floor` is a library call on the x86-64 baseline (no SSE4.1
-/// `roundsd`); a truncating cast and a compare are a few cycles.
-#[inline(always)]
-pub(crate) fn fast_floor(x: f64) -> i64 {
-    if x.abs() < FAST {
-        let i = x as i64;
-        i - i64::from((i as f64) > x)
-    } else {
-        floor_index(x)
-    }
-}
 
 /// Floor (saturating, as an index) and fraction in [0, 1] of a texel-space
 /// coordinate; the fraction is 0 for non-finite or huge input (there is
@@ -206,8 +188,8 @@ fn nearest_edge<P: Pixel, S: TexelSink>(
     sink: &mut S,
 ) -> [f32; 4] {
     let l = &c.levels[li];
-    let i = fast_floor(reduce_f64(u, a.wrap.u) * l.wf);
-    let j = fast_floor(reduce_f64(v, a.wrap.v) * l.hf);
+    let i = fast_floor(reduce_coordinate(u, a.wrap.u) * l.wf);
+    let j = fast_floor(reduce_coordinate(v, a.wrap.v) * l.hf);
     l.fetch(&c.lut, li as u32, i, j, a, sink)
 }
 
@@ -283,8 +265,8 @@ fn bilinear_edge<P: Pixel, S: TexelSink>(
     sink: &mut S,
 ) -> [f32; 4] {
     let l = &c.levels[li];
-    let (i0, al) = split(reduce_f64(u, a.wrap.u) * l.wf - 0.5);
-    let (j0, be) = split(reduce_f64(v, a.wrap.v) * l.hf - 0.5);
+    let (i0, al) = split(reduce_coordinate(u, a.wrap.u) * l.wf - 0.5);
+    let (j0, be) = split(reduce_coordinate(v, a.wrap.v) * l.hf - 0.5);
     let (x0, x1) = axis_pair(a.wrap.u, i0, l.w);
     let (y0, y1) = axis_pair(a.wrap.v, j0, l.h);
     let mut get = |x: Option<u32>, y: Option<u32>| match (x, y) {

@@ -55,9 +55,9 @@
 //! ellipse is the same texel). So a query reads at most about
 //! 2·π·(MAX_RADIUS + 1)² texels.
 
-use crate::wrap::WrapMode;
+use crate::wrap::{WrapMode, fast_floor};
 
-use super::bilinear::{fast_floor, split};
+use super::bilinear::split;
 use super::fetch::{Addressing, Chain, Pixel, lerp};
 use super::footprint::{Lod, clamp_lod, derivatives, levels_for, log2};
 use super::trace::TexelSink;

@@ -40,11 +40,10 @@
 use std::arch::x86_64::*;
 use std::mem::MaybeUninit;
 
-use super::bilinear::fast_floor;
 use super::ewa::{MAX_LINES, WEIGHT_POLY, weight_poly};
 use super::fetch::Lut8;
 use super::simd::decode_rgba8;
-use crate::wrap::{WrapMode, wrap_index};
+use crate::wrap::{WrapMode, fast_floor, wrap_index};
 
 /// Texels the buffer holds before it is summed (runs are at most about
 /// `2·MAX_RADIUS + 3` texels, far below this).

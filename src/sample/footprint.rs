@@ -19,9 +19,8 @@
 //! The isotropic nearest-mip path does not take the logarithm at all:
 //! `Lod` restates SPEC's rounding rule on ρ² (exact at the thresholds).
 
-use crate::wrap::WrapMode;
+use crate::wrap::{WrapMode, reduce_coordinate};
 
-use super::bilinear::fast_floor;
 use super::{MipMode, Query, SamplerOptions};
 
 /// Size in level-0 texels assumed for a footprint with a NaN or infinite
@@ -478,20 +477,7 @@ impl Lod {
 
 #[inline(always)]
 fn reduce(x: f32, mode: WrapMode) -> f64 {
-    reduce_f64(x as f64, mode)
-}
-
-/// One coordinate moved into the first period of `repeat` (period 1) or
-/// `mirror` (period 2), exactly (`x − floor(x)` has no rounding in `f64`);
-/// NaN reads as 0, infinities and the other modes pass through.
-#[inline(always)]
-pub(crate) fn reduce_f64(x: f64, mode: WrapMode) -> f64 {
-    let x = if x.is_nan() { 0.0 } else { x };
-    match mode {
-        WrapMode::Repeat if x.is_finite() => x - fast_floor(x) as f64,
-        WrapMode::MirroredRepeat if x.is_finite() => x - 2.0 * fast_floor(0.5 * x) as f64,
-        _ => x,
-    }
+    reduce_coordinate(x as f64, mode)
 }
 
 #[cfg(test)]

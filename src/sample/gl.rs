@@ -42,11 +42,11 @@ use std::fmt;
 use std::str::FromStr;
 
 use crate::error::{Error, Result};
-use crate::wrap::wrap_index;
+use crate::wrap::{fast_floor, reduce_coordinate, wrap_index};
 
-use super::bilinear::{fast_floor, split};
+use super::bilinear::split;
 use super::fetch::{Addressing, Chain, Level, Pixel};
-use super::footprint::{Lod, Plan, reduce_f64};
+use super::footprint::{Lod, Plan};
 use super::trace::NoTrace;
 use super::{MipMode, Query, SamplerOptions, TexelFilter};
 
@@ -220,8 +220,8 @@ fn taps<P: Pixel>(l: &Level<P>, filter: TexelFilter, u: f64, v: f64, a: &Address
 #[inline]
 fn reduced(a: &Addressing, u: f32, v: f32) -> (f64, f64) {
     (
-        reduce_f64(u as f64, a.wrap.u),
-        reduce_f64(v as f64, a.wrap.v),
+        reduce_coordinate(u as f64, a.wrap.u),
+        reduce_coordinate(v as f64, a.wrap.v),
     )
 }
 

@@ -52,7 +52,6 @@
 #![allow(unsafe_code)]
 
 use std::arch::x86_64::*;
-use std::sync::OnceLock;
 
 use super::aniso::Setup;
 use super::bilinear::Lin;
@@ -65,15 +64,7 @@ use super::{Query, SamplerOptions, aniso};
 /// True when the CPU has the features these paths need and
 /// `PARVO_NO_AVX` is not set (checked once).
 pub(crate) fn available() -> bool {
-    static OK: OnceLock<bool> = OnceLock::new();
-    *OK.get_or_init(|| {
-        crate::cpu::simd_allowed()
-            && is_x86_feature_detected!("avx512f")
-            && is_x86_feature_detected!("avx512bw")
-            && is_x86_feature_detected!("avx512dq")
-            && is_x86_feature_detected!("avx512vl")
-            && is_x86_feature_detected!("avx512vbmi")
-    })
+    crate::cpu::avx512_sample()
 }
 
 /// Most levels the per-lane level tables hold (a 32768-texel side).

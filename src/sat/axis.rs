@@ -25,7 +25,7 @@
 //! exactly instead of in floating point. Rectangles inside the level take a
 //! shortcut: the four reads of each end, nothing to wrap.
 
-use crate::wrap::{WrapMode, floor_index, wrap_index};
+use crate::wrap::{WrapMode, floor_index, period, wrap_index};
 
 const N: usize = 12;
 
@@ -77,22 +77,22 @@ impl IntTerms {
     }
 
     fn cumulative(&mut self, mode: WrapMode, x: i64, n: i64, sign: i64) {
-        match mode {
-            WrapMode::Repeat => {
-                let (q, r) = (x.div_euclid(n), x.rem_euclid(n));
-                self.push(n, sign * q);
+        if let Some(p) = period(mode, n) {
+            // Whole periods and the rest, `x = q · p + r`: a period holds
+            // the tile once (repeat) or twice (mirror, the tile and its
+            // mirror image); a rest past the tile (mirror only) is the
+            // next period less the mirrored part it lacks.
+            let (q, r) = (x.div_euclid(p), x.rem_euclid(p));
+            if r <= n {
+                self.push(n, sign * (p / n) * q);
                 self.push(r, sign);
+            } else {
+                self.push(n, sign * (2 * q + 2));
+                self.push(2 * n - r, -sign);
             }
-            WrapMode::MirroredRepeat => {
-                let (q, r) = (x.div_euclid(2 * n), x.rem_euclid(2 * n));
-                if r <= n {
-                    self.push(n, sign * 2 * q);
-                    self.push(r, sign);
-                } else {
-                    self.push(n, sign * (2 * q + 2));
-                    self.push(2 * n - r, -sign);
-                }
-            }
+            return;
+        }
+        match mode {
             WrapMode::ClampToEdge => self.clamp_edge(x, n, sign),
             WrapMode::ClampToBorder => self.push(x.clamp(0, n), sign),
             WrapMode::MirrorClampToEdge => {
@@ -102,6 +102,8 @@ impl IntTerms {
                     self.clamp_edge(-x, n, -sign);
                 }
             }
+            // Periodic: done above.
+            WrapMode::Repeat | WrapMode::MirroredRepeat => {}
         }
     }
 }

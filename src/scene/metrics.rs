@@ -70,3 +70,23 @@ pub fn rms_change(a: &Pixels, b: &Pixels) -> f64 {
 pub fn flicker(filter: (&Pixels, &Pixels), reference: (&Pixels, &Pixels)) -> f64 {
     rms_change(filter.0, filter.1) - rms_change(reference.0, reference.1)
 }
+
+/// The error-map scale: the 99th percentile of the per-pixel absolute
+/// error (the mean over R, G, B of pixels both images have), so a few
+/// outliers do not wash an error map out; at least 1e-4, and 1 when no
+/// pixel is compared.
+pub fn error_scale(img: &Pixels, reference: &Pixels) -> f64 {
+    let mut e: Vec<f64> = img
+        .iter()
+        .zip(reference)
+        .filter_map(|(a, r)| {
+            let (a, r) = (a.as_ref()?, r.as_ref()?);
+            Some((0..3).map(|c| (a[c] - r[c]).abs() as f64).sum::<f64>() / 3.0)
+        })
+        .collect();
+    if e.is_empty() {
+        return 1.0;
+    }
+    e.sort_by(f64::total_cmp);
+    e[(e.len() * 99 / 100).min(e.len() - 1)].max(1e-4)
+}
