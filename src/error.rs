@@ -71,6 +71,7 @@ pub enum Error {
     /// A setting of the mip pipeline that does not fit the job or another
     /// setting: which setting, which value, which container. Front ends
     /// say it in their own option names.
+    #[cfg(feature = "io")]
     #[error("invalid option: {0}")]
     Usage(crate::pipeline::Usage),
     /// A file or directory could not be opened, read or written.

@@ -580,9 +580,63 @@ fn roughness_settings(args: &MipArgs) -> Result<Option<RoughnessSettings>, Strin
 }
 
 pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
+    let (jobs, settings) = match jobs_and_settings(&args) {
+        Ok(js) => js,
+        Err(code) => return Ok(code),
+    };
+    // Report panics (bugs in parvo or a dependency) as per-file errors, not
+    // as the default multi-line message.
+    std::panic::set_hook(Box::new(|_| {}));
+    super::remove_temporary_files_on_interrupt();
+    let tty = std::io::stderr().is_terminal() && !args.json;
+    let batch = jobs.len() > 1;
+    let bar = if tty {
+        let template = if batch {
+            super::BAR_FILES
+        } else {
+            super::BAR_PERCENT
+        };
+        Some(
+            ProgressBar::new(if batch { jobs.len() as u64 } else { 0 })
+                .with_style(super::bar_style(template)?),
+        )
+    } else {
+        None
+    };
+    let out = Printer {
+        args: &args,
+        bar: bar.as_ref(),
+        batch,
+        started: Instant::now(),
+        failed: Mutex::new(0),
+        print: Mutex::new(()),
+    };
+    let single = jobs.first().map(|j| (j.input.clone(), j.output.clone()));
+    let mut progress = |stage: Stage| {
+        if let (Some(b), Some((input, output))) = (&bar, &single) {
+            show_stage(b, input, output, stage);
+        }
+    };
+    pipeline::run(&jobs, &settings, &mut progress, &|job, result| {
+        out.done(job, result)
+    });
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let failed = *out.failed.lock().unwrap_or_else(|e| e.into_inner());
+    Ok(if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// The jobs and settings of `args`, or the exit code of a usage problem
+/// (said on stderr), found before any input is read.
+fn jobs_and_settings(args: &MipArgs) -> Result<(Vec<Job>, Settings), ExitCode> {
     let usage = |msg: String| {
         eprintln!("parvo: {}", super::words(msg));
-        Ok(ExitCode::from(2))
+        Err(ExitCode::from(2))
     };
     if let Some(n) = args.threads {
         if n == 0 {
@@ -621,101 +675,98 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
                     "parvo: cannot create the output directory {}: {e}",
                     dir.display()
                 );
-                return Ok(ExitCode::from(1));
+                return Err(ExitCode::from(1));
             }
             Job::batch(&inputs, dir, args.ext)
         }
         _ => return usage("give -o OUTPUT (one input) or --out-dir DIR (a batch)".into()),
     };
-    let mut settings = settings(&args);
-    match roughness_settings(&args) {
+    let mut settings = settings(args);
+    match roughness_settings(args) {
         Ok(r) => settings.roughness = r,
         Err(e) => return usage(e),
     }
-    // Usage errors, found before any input is read.
     if let Err(e) = pipeline::check(&jobs, &settings) {
         return usage(super::error_text(&e));
     }
-    // Report panics (bugs in parvo or a dependency) as per-file errors, not
-    // as the default multi-line message.
-    std::panic::set_hook(Box::new(|_| {}));
-    super::remove_temporary_files_on_interrupt();
-    let tty = std::io::stderr().is_terminal() && !args.json;
-    let batch = jobs.len() > 1;
-    let bar = if tty {
-        let template = if batch {
-            super::BAR_FILES
-        } else {
-            super::BAR_PERCENT
-        };
-        Some(
-            ProgressBar::new(if batch { jobs.len() as u64 } else { 0 })
-                .with_style(super::bar_style(template)?),
-        )
-    } else {
-        None
-    };
-    let failed = Mutex::new(0usize);
-    let print = Mutex::new(());
-    let started = Instant::now();
-    let single = jobs.first().map(|j| (j.input.clone(), j.output.clone()));
-    let mut progress = |stage: Stage| {
-        let (Some(b), Some((input, output))) = (&bar, &single) else {
-            return;
-        };
-        match stage {
-            Stage::Building { total_texels } => {
-                b.set_length(total_texels.max(1));
-                b.set_message(input.clone());
-            }
-            Stage::Built { texels_done } => b.set_position(texels_done),
-            Stage::Encoding { total_texels } => {
-                b.set_length(total_texels.max(1));
-                b.set_position(0);
-                b.set_message(format!("{input}: block-compressing"));
-            }
-            Stage::Encoded { texels_done } => b.set_position(texels_done),
-            Stage::Writing => b.set_message(format!("{input}: writing {}", output.display())),
+    Ok((jobs, settings))
+}
+
+/// A single job's progress on its bar.
+fn show_stage(b: &ProgressBar, input: &str, output: &std::path::Path, stage: Stage) {
+    match stage {
+        Stage::Building { total_texels } => {
+            b.set_length(total_texels.max(1));
+            b.set_message(input.to_string());
         }
-    };
-    let done = |job: &Job, result: parvo::Result<Outcome>| {
-        // A single job's time is the run's; a batch's jobs overlap, so
-        // each reports the sum of its own phases.
-        let secs = started.elapsed().as_secs_f64();
-        let _guard = print.lock().unwrap_or_else(|e| e.into_inner());
-        let line = |s: String| match &bar {
+        Stage::Built { texels_done } => b.set_position(texels_done),
+        Stage::Encoding { total_texels } => {
+            b.set_length(total_texels.max(1));
+            b.set_position(0);
+            b.set_message(format!("{input}: block-compressing"));
+        }
+        Stage::Encoded { texels_done } => b.set_position(texels_done),
+        Stage::Writing => b.set_message(format!("{input}: writing {}", output.display())),
+    }
+}
+
+/// How `run` reports finished jobs: one line each (text or JSON) on
+/// stdout, notes and errors on stderr, around the progress bar.
+struct Printer<'a> {
+    args: &'a MipArgs,
+    bar: Option<&'a ProgressBar>,
+    batch: bool,
+    started: Instant,
+    failed: Mutex<usize>,
+    print: Mutex<()>,
+}
+
+impl Printer<'_> {
+    fn line(&self, s: String) {
+        match self.bar {
             Some(b) => b.suspend(|| println!("{s}")),
             None => println!("{s}"),
-        };
-        let warn = |s: String| match &bar {
+        }
+    }
+
+    fn warn(&self, s: String) {
+        match self.bar {
             Some(b) => b.suspend(|| eprintln!("{}", super::words(&s))),
             None => eprintln!("{}", super::words(&s)),
-        };
+        }
+    }
+
+    fn done(&self, job: &Job, result: parvo::Result<Outcome>) {
+        // A single job's time is the run's; a batch's jobs overlap, so
+        // each reports the sum of its own phases.
+        let secs = self.started.elapsed().as_secs_f64();
+        let _guard = self.print.lock().unwrap_or_else(|e| e.into_inner());
+        let args = self.args;
         match result {
             Ok(o) => {
-                let secs = if batch {
+                let secs = if self.batch {
                     o.read_s + o.build_s + o.write_s
                 } else {
                     secs
                 };
                 for n in &o.notes {
-                    warn(format!("parvo: {}: {}", job.input, note_text(n)));
+                    self.warn(format!("parvo: {}: {}", job.input, note_text(n)));
                 }
                 if args.json {
-                    line(json_line(job, &o, secs));
+                    self.line(json_line(job, &o, secs));
                 } else {
-                    line(summary_line(job, &o, &args, secs));
+                    self.line(summary_line(job, &o, args, secs));
                     if args.stats {
-                        line(stats_line(&o));
+                        self.line(stats_line(&o));
                     }
                 }
             }
             Err(e) => {
-                *failed.lock().unwrap_or_else(|e| e.into_inner()) += 1;
+                *self.failed.lock().unwrap_or_else(|e| e.into_inner()) += 1;
                 let msg = super::error_text(&e).replace('\n', " ");
-                warn(format!("parvo: {}: {msg}", job.input));
+                self.warn(format!("parvo: {}: {msg}", job.input));
                 if args.json {
-                    line(
+                    self.line(
                         serde_json::json!({
                             "input": job.input,
                             "output": job.output,
@@ -727,20 +778,12 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
                 }
             }
         }
-        if batch && let Some(b) = &bar {
+        if self.batch
+            && let Some(b) = self.bar
+        {
             b.inc(1);
         }
-    };
-    pipeline::run(&jobs, &settings, &mut progress, &done);
-    if let Some(b) = &bar {
-        b.finish_and_clear();
     }
-    let failed = *failed.lock().unwrap_or_else(|e| e.into_inner());
-    Ok(if failed == 0 {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
 }
 
 fn summary_line(job: &Job, o: &Outcome, args: &MipArgs, secs: f64) -> String {

@@ -28,17 +28,30 @@ use tempfile::NamedTempFile;
 use crate::error::{Error, Result};
 
 /// Temporary files that exist right now (created, not yet renamed or
-/// deleted).
-static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// deleted), and whether [`remove_temporary_files`] has run.
+struct Live {
+    paths: Vec<PathBuf>,
+    closed: bool,
+}
 
-fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+static LIVE: Mutex<Live> = Mutex::new(Live {
+    paths: Vec::new(),
+    closed: false,
+});
+
+fn live() -> std::sync::MutexGuard<'static, Live> {
     LIVE.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// Delete every temporary file parvo is writing or has staged, for a
 /// signal handler about to exit the process. Destinations are untouched.
+/// No temporary file is created after it (a writer that tries gets an
+/// error): a file is created and registered under the same lock, so none
+/// made while the handler runs is missed.
 pub fn remove_temporary_files() {
-    for p in live().drain(..) {
+    let mut l = live();
+    l.closed = true;
+    for p in l.paths.drain(..) {
         let _ = std::fs::remove_file(p);
     }
 }
@@ -49,15 +62,27 @@ pub fn remove_temporary_files() {
 struct Registered(PathBuf);
 
 impl Registered {
-    fn new(path: &Path) -> Self {
-        live().push(path.to_path_buf());
-        Registered(path.to_path_buf())
+    /// Create a temporary file with `make` and register it, unless
+    /// [`remove_temporary_files`] has run.
+    fn create(
+        make: impl FnOnce() -> std::io::Result<NamedTempFile>,
+    ) -> std::io::Result<(Self, NamedTempFile)> {
+        let mut l = live();
+        if l.closed {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "interrupted: no new file is written",
+            ));
+        }
+        let tmp = make()?;
+        l.paths.push(tmp.path().to_path_buf());
+        Ok((Registered(tmp.path().to_path_buf()), tmp))
     }
 }
 
 impl Drop for Registered {
     fn drop(&mut self) {
-        live().retain(|p| *p != self.0);
+        live().paths.retain(|p| *p != self.0);
     }
 }
 
@@ -139,22 +164,22 @@ where
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let tmp = builder.tempfile_in(dir).map_err(|e| Error::Io {
-        path: dir.to_path_buf(),
-        action: format!("cannot create a file in {}", dir.display()),
-        // tempfile appends the random temporary name; keep only the
-        // operating system's reason.
-        error: {
-            let msg = e.to_string();
-            let reason = msg.split(" at path ").next().unwrap_or(&msg).to_string();
-            std::io::Error::new(e.kind(), reason)
-        },
-    })?;
+    let (registered, tmp) =
+        Registered::create(|| builder.tempfile_in(dir)).map_err(|e| Error::Io {
+            path: dir.to_path_buf(),
+            action: format!("cannot create a file in {}", dir.display()),
+            // tempfile appends the random temporary name; keep only the
+            // operating system's reason.
+            error: {
+                let msg = e.to_string();
+                let reason = msg.split(" at path ").next().unwrap_or(&msg).to_string();
+                std::io::Error::new(e.kind(), reason)
+            },
+        })?;
     // Replacing a file keeps its permissions.
     if let Ok(meta) = std::fs::metadata(dest) {
         let _ = tmp.as_file().set_permissions(meta.permissions());
     }
-    let registered = Registered::new(tmp.path());
     let io_err = |e: std::io::Error| Error::Io {
         path: dest.to_path_buf(),
         action: format!("cannot write {}", dest.display()),
@@ -260,9 +285,9 @@ mod tests {
         })
         .unwrap();
         let tmp_path = a.tmp.path().to_path_buf();
-        assert!(live().contains(&tmp_path));
+        assert!(live().paths.contains(&tmp_path));
         a.commit().unwrap();
-        assert!(!live().contains(&tmp_path));
+        assert!(!live().paths.contains(&tmp_path));
         let b = stage(&dir.path().join("b"), |w| {
             w.write_all(b"b").unwrap();
             Ok(())

@@ -31,6 +31,7 @@
 //! level 0 in f32, on the separable path).
 
 pub mod alpha;
+#[cfg(feature = "io")]
 pub(crate) mod band;
 pub mod fast;
 pub mod kernel;
