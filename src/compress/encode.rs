@@ -149,43 +149,55 @@ pub fn encode(format: BlockFormat, quality: Quality, level: &Texture) -> Result<
             }
         }
         (BlockFormat::Bc6h { .. }, Texels::F16(v)) => {
-            // ISPC reads RGBA halves; unsigned half has no negatives, and
-            // NaN or infinity have no block encoding: clamp to [0, MAX].
-            let mut rgba = Vec::with_capacity(w * h * 8);
-            for px in v.chunks_exact(3) {
-                for c in px.iter().copied().chain([half::f16::ONE]) {
-                    let x = c.to_f32();
-                    let x = if x.is_nan() || x <= 0.0 {
-                        half::f16::ZERO
-                    } else if x > 65504.0 {
-                        half::f16::MAX
-                    } else {
-                        c
-                    };
-                    rgba.extend_from_slice(&x.to_bits().to_le_bytes());
-                }
-            }
-            let s = match quality {
-                Quality::Fast => intel_tex_2::bc6h::very_fast_settings(),
-                Quality::Normal => intel_tex_2::bc6h::basic_settings(),
-                Quality::Slow => intel_tex_2::bc6h::slow_settings(),
-            };
-            ispc_bands(&rgba, w, h, 8, format, &mut out, |band, bw, bh, dst| {
-                intel_tex_2::bc6h::compress_blocks_into(
-                    &s,
-                    &intel_tex_2::RgbaSurface {
-                        data: band,
-                        width: bw as u32,
-                        height: bh as u32,
-                        stride: (bw * 8) as u32,
-                    },
-                    dst,
-                )
-            });
+            encode_bc6h(v, w, h, format, quality, &mut out)
         }
         _ => return Err(encode_err(format!("{format} cannot encode {f} texels"))),
     }
     Ok(out)
+}
+
+/// BC6H (unsigned half) blocks of an RGB f16 level into `out`.
+fn encode_bc6h(
+    v: &[half::f16],
+    w: usize,
+    h: usize,
+    format: BlockFormat,
+    quality: Quality,
+    out: &mut [u8],
+) {
+    // ISPC reads RGBA halves; unsigned half has no negatives, and
+    // NaN or infinity have no block encoding: clamp to [0, MAX].
+    let mut rgba = Vec::with_capacity(w * h * 8);
+    for px in v.chunks_exact(3) {
+        for c in px.iter().copied().chain([half::f16::ONE]) {
+            let x = c.to_f32();
+            let x = if x.is_nan() || x <= 0.0 {
+                half::f16::ZERO
+            } else if x > 65504.0 {
+                half::f16::MAX
+            } else {
+                c
+            };
+            rgba.extend_from_slice(&x.to_bits().to_le_bytes());
+        }
+    }
+    let s = match quality {
+        Quality::Fast => intel_tex_2::bc6h::very_fast_settings(),
+        Quality::Normal => intel_tex_2::bc6h::basic_settings(),
+        Quality::Slow => intel_tex_2::bc6h::slow_settings(),
+    };
+    ispc_bands(&rgba, w, h, 8, format, out, |band, bw, bh, dst| {
+        intel_tex_2::bc6h::compress_blocks_into(
+            &s,
+            &intel_tex_2::RgbaSurface {
+                data: band,
+                width: bw as u32,
+                height: bh as u32,
+                stride: (bw * 8) as u32,
+            },
+            dst,
+        )
+    });
 }
 
 /// Run an ISPC kernel over bands of [`BAND_BLOCK_ROWS`] block rows in

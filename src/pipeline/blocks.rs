@@ -180,32 +180,7 @@ pub(crate) fn encode_chain(
         }
         if measure {
             // After the encode, so the encode times do not include it.
-            let ch = match bf {
-                BlockFormat::Bc4 { .. } => 1,
-                BlockFormat::Bc5 { .. } => 2,
-                BlockFormat::Bc6h { .. } => 3,
-                _ if want.alpha == AlphaMode::None => 3,
-                _ => 4,
-            };
-            let scores = levels
-                .par_iter()
-                .zip(&data)
-                .map(|(l, d)| {
-                    let input = crate::compress::prepare(l, bf, want)?;
-                    let dec = crate::compress::decode(
-                        bf,
-                        want.color_space == ColorSpace::Srgb,
-                        want.alpha,
-                        l.width(),
-                        l.height(),
-                        d,
-                    )?;
-                    crate::compress::psnr(&input, &dec, ch)
-                })
-                .collect::<Result<Vec<_>>>()?;
-            for (lv, p) in report_levels.iter_mut().zip(scores) {
-                lv.psnr_db = Some(p);
-            }
+            measure_psnr(levels, &data, bf, want, &mut report_levels)?;
         }
         let srgb = want.color_space == ColorSpace::Srgb;
         let chain = BlockChain {
@@ -228,6 +203,45 @@ pub(crate) fn encode_chain(
             },
         ))
     }
+}
+
+/// Each level's PSNR against the uncompressed level, the blocks decoded
+/// again by the independent decoder (`compress::decode`).
+#[cfg(feature = "encode")]
+fn measure_psnr(
+    levels: &[Texture],
+    data: &[Vec<u8>],
+    bf: BlockFormat,
+    want: crate::texel::Format,
+    report: &mut [BlockLevel],
+) -> Result<()> {
+    let ch = match bf {
+        BlockFormat::Bc4 { .. } => 1,
+        BlockFormat::Bc5 { .. } => 2,
+        BlockFormat::Bc6h { .. } => 3,
+        _ if want.alpha == AlphaMode::None => 3,
+        _ => 4,
+    };
+    let scores = levels
+        .par_iter()
+        .zip(data)
+        .map(|(l, d)| {
+            let input = crate::compress::prepare(l, bf, want)?;
+            let dec = crate::compress::decode(
+                bf,
+                want.color_space == ColorSpace::Srgb,
+                want.alpha,
+                l.width(),
+                l.height(),
+                d,
+            )?;
+            crate::compress::psnr(&input, &dec, ch)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    for (lv, p) in report.iter_mut().zip(scores) {
+        lv.psnr_db = Some(p);
+    }
+    Ok(())
 }
 
 #[cfg(test)]
