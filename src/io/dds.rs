@@ -1211,14 +1211,10 @@ pub fn read_header(path: &Path) -> Result<Header> {
     Header::parse(&head)
 }
 
-/// Load a DDS file: every mip level of a 2-D texture (see the module docs
-/// for the formats read).
-pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
-    let header = read_header(path)?;
-    let (w, h) = (header.width, header.height);
-    if w == 0 || h == 0 {
-        return Err(decode_err(format!("the header declares a {w}x{h} texture")));
-    }
+/// The kinds of DDS file parvo does not read (cube maps, volumes, arrays,
+/// buffers), refused in words before any texel is read.
+fn refuse_unsupported(header: &Header) -> Result<()> {
+    let h = header.height;
     if header.caps2 & caps::CUBEMAP != 0
         || header
             .dx10
@@ -1270,6 +1266,18 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
             }
         }
     }
+    Ok(())
+}
+
+/// Load a DDS file: every mip level of a 2-D texture (see the module docs
+/// for the formats read).
+pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
+    let header = read_header(path)?;
+    let (w, h) = (header.width, header.height);
+    if w == 0 || h == 0 {
+        return Err(decode_err(format!("the header declares a {w}x{h} texture")));
+    }
+    refuse_unsupported(&header)?;
     let (stored, desc) = stored_of(&header)?;
     let full = crate::mip::level_count(w, h, crate::mip::Rounding::Down, None);
     let declared = header.mip_map_count.max(1);
