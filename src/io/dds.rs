@@ -1401,14 +1401,7 @@ impl super::Container for Dds {
             float: true,
             integer: true,
             blocks: true,
-            whole_chain: false,
-            round_up: false,
-            fingerprint: false,
-            supercompression: false,
-            channel_names: false,
-            file_per_level: false,
-            streamed_level0: false,
-            alpha: None,
+            ..super::Stores::NOTHING
         })
     }
     fn storable(&self, f: Format) -> Format {

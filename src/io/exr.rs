@@ -1279,16 +1279,13 @@ impl super::Container for OpenExr {
     fn stores(&self) -> Option<super::Stores> {
         Some(super::Stores {
             float: true,
-            integer: false,
-            blocks: false,
             whole_chain: true,
             round_up: true,
             fingerprint: true,
-            supercompression: false,
             channel_names: true,
-            file_per_level: false,
             streamed_level0: true,
             alpha: Some(crate::texel::AlphaMode::Premultiplied),
+            ..super::Stores::NOTHING
         })
     }
     fn default_type(&self, src: ChannelType) -> ChannelType {

@@ -1079,14 +1079,9 @@ impl super::Container for Ktx2 {
             float: true,
             integer: true,
             blocks: true,
-            whole_chain: false,
-            round_up: false,
             fingerprint: true,
             supercompression: true,
-            channel_names: false,
-            file_per_level: false,
-            streamed_level0: false,
-            alpha: None,
+            ..super::Stores::NOTHING
         })
     }
     fn storable(&self, f: Format) -> Format {

@@ -151,17 +151,11 @@ impl super::Container for PngLevels {
     }
     fn stores(&self) -> Option<super::Stores> {
         Some(super::Stores {
-            float: false,
             integer: true,
-            blocks: false,
-            whole_chain: false,
             round_up: true,
-            fingerprint: false,
-            supercompression: false,
-            channel_names: false,
             file_per_level: true,
-            streamed_level0: false,
             alpha: Some(crate::texel::AlphaMode::Straight),
+            ..super::Stores::NOTHING
         })
     }
     fn output_hint(&self) -> String {
