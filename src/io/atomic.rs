@@ -288,6 +288,31 @@ mod tests {
         assert!(live().paths.contains(&tmp_path));
         a.commit().unwrap();
         assert!(!live().paths.contains(&tmp_path));
+    }
+
+    /// `remove_temporary_files` closes the process for new temporary
+    /// files, so it runs in a child process of its own (the test binary
+    /// re-run on the ignored test below), never beside the other tests.
+    #[test]
+    fn removing_temporary_files_deletes_staged_ones_and_refuses_new_ones() {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "io::atomic::tests::remove_temporary_files_in_a_child_process",
+                "--ignored",
+                "--test-threads=1",
+            ])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{text}");
+        assert!(text.contains("1 passed"), "the child test ran: {text}");
+    }
+
+    #[test]
+    #[ignore = "run in a child process by the test above"]
+    fn remove_temporary_files_in_a_child_process() {
+        let dir = tempfile::tempdir().unwrap();
         let b = stage(&dir.path().join("b"), |w| {
             w.write_all(b"b").unwrap();
             Ok(())
@@ -298,5 +323,11 @@ mod tests {
         assert!(!b_tmp.exists(), "removed by the signal-handler path");
         drop(b);
         assert!(!dir.path().join("b").exists());
+        let e = write(&dir.path().join("c"), |w| {
+            w.write_all(b"c").unwrap();
+            Ok(())
+        });
+        assert!(e.unwrap_err().to_string().contains("interrupted"));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 }
