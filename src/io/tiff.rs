@@ -148,7 +148,7 @@ impl Reader<'_> {
                 "channels of different sample formats (integer and float) are not supported",
             ));
         }
-        let bits = bits[0];
+        let (bits, sample_format) = (bits[0], sample_format[0]);
         let mut extra: Vec<u16> = d
             .find_tag_unsigned_vec::<u16>(Tag::ExtraSamples)
             .map_err(|e| self.err(e))?
@@ -162,133 +162,25 @@ impl Reader<'_> {
             Some(p) => p,
             None => fix.told.unwrap_or(1) as u64,
         };
-        let colour = match photometric {
-            1 | 3 => 1,
-            2 => 3,
-            // The crate inverts one WhiteIsZero channel (as libtiff
-            // and OpenImageIO read it: 0 is white).
-            0 if stored_samples == 1 && matches!(bits, 1 | 2 | 4 | 8 | 16 | 32 | 64) => 1,
-            0 if stored_samples == 1 => {
-                return Err(decode_err(format!(
-                    "WhiteIsZero (inverted grey) TIFF of {}-bit samples is not supported (1, 2, \
-                     4, 8 and 16 bits are)",
-                    bits
-                )));
-            }
-            0 => {
-                return Err(decode_err(
-                    "WhiteIsZero (inverted grey) TIFF with an alpha or extra channel is not \
-                     supported",
-                ));
-            }
-            4 => return Err(decode_err("transparency-mask TIFF is not supported")),
-            5 => return Err(decode_err("CMYK TIFF is not supported")),
-            6 => return Err(decode_err("YCbCr TIFF is not supported (store it as RGB)")),
-            8..=10 => return Err(decode_err("CIE L*a*b* TIFF is not supported")),
-            32844 | 32845 => return Err(decode_err("LogLuv (SGI) TIFF is not supported")),
-            u64::MAX => {
-                return Err(decode_err(
-                    "the PhotometricInterpretation tag does not hold one number",
-                ));
-            }
-            p => {
-                return Err(decode_err(format!(
-                    "photometric interpretation {p} is not supported"
-                )));
-            }
-        };
-        // FillOrder 2 stores the bits of each byte in reverse; libtiff
-        // reverses them before decoding, which for uncompressed data
-        // without a predictor is reversing the decoded bytes.
-        let bit_reversed = match self.unsigned(d, Tag::FillOrder)?.unwrap_or(1) {
-            1 => false,
-            2 if self.unsigned(d, Tag::Compression)?.unwrap_or(1) == 1
-                && self.unsigned(d, Tag::Predictor)?.unwrap_or(1) == 1 =>
-            {
-                true
-            }
-            2 => {
-                return Err(decode_err(
-                    "FillOrder 2 (bits stored least significant first) is supported for \
-                     uncompressed data without a predictor only",
-                ));
-            }
-            f => return Err(decode_err(format!("FillOrder {f} is neither 1 nor 2"))),
-        };
+        let colour = colour_channels(photometric, stored_samples, bits)?;
+        let bit_reversed = self.bit_reversed(d)?;
         if !(1..=4).contains(&stored_samples) || stored_samples < colour {
             return Err(decode_err(format!(
                 "{stored_samples} samples per pixel: parvo reads 1 to 4 channels"
             )));
         }
         let palette = if photometric == 3 {
-            if stored_samples != 1 || !matches!(bits, 1 | 2 | 4 | 8 | 16) || sample_format[0] != 1 {
-                return Err(decode_err(format!(
-                    "a palette image of {stored_samples} samples of {bits} bits is not supported \
-                     (one index of 1, 2, 4, 8 or 16 bits is)"
-                )));
-            }
-            let map = d
-                .find_tag_unsigned_vec::<u16>(Tag::ColorMap)
-                .map_err(|e| self.err(e))?
-                .ok_or_else(|| decode_err("a palette image without a ColorMap tag"))?;
-            let want = 3usize << bits;
-            if map.len() != want {
-                return Err(decode_err(format!(
-                    "the ColorMap has {} entries, a palette of {bits}-bit indices has {want}",
-                    map.len()
-                )));
-            }
-            Some(map)
+            Some(self.palette(d, stored_samples, bits, sample_format)?)
         } else {
             None
         };
-        let ty = match (sample_format[0], bits) {
-            _ if palette.is_some() => ChannelType::U8,
-            (1, 1..=7) if stored_samples == 1 => ChannelType::U8,
-            (1, 8) => ChannelType::U8,
-            (1, 16) => ChannelType::U16,
-            (3, 16) => ChannelType::F16,
-            (3, 32) | (3, 64) => ChannelType::F32,
-            (1, b) if b < 8 => {
-                return Err(decode_err(format!(
-                    "{b}-bit samples are supported for one grey channel, not for {stored_samples} \
-                     channels"
-                )));
-            }
-            (1, b) => {
-                return Err(decode_err(format!(
-                    "{b}-bit unsigned integer samples are not supported (8 and 16 are)"
-                )));
-            }
-            (2, b) => {
-                return Err(decode_err(format!(
-                    "signed {b}-bit samples are not supported"
-                )));
-            }
-            (f, b) => {
-                return Err(decode_err(format!(
-                    "sample format {f} with {b} bits is not supported"
-                )));
-            }
-        };
+        let ty = channel_type(sample_format, bits, stored_samples, palette.is_some())?;
         let has_alpha_slot = stored_samples == 2 || stored_samples == 4;
         let (alpha, alpha_note) = if missing && stored_samples == 2 && extra.is_empty() {
             // OpenImageIO reads two untagged channels as R, G data.
             (AlphaMode::None, None)
         } else if stored_samples > colour {
-            match extra.first() {
-                Some(1) => (AlphaMode::Premultiplied, None),
-                Some(2) => (AlphaMode::Straight, None),
-                Some(_) => (AlphaMode::None, None),
-                None if has_alpha_slot => (
-                    AlphaMode::Premultiplied,
-                    Some(
-                        "no ExtraSamples tag: the last channel is taken as associated alpha, as \
-                         OpenImageIO does",
-                    ),
-                ),
-                None => (AlphaMode::None, None),
-            }
+            extra_alpha(extra.first().copied(), has_alpha_slot)
         } else {
             (AlphaMode::Straight, None)
         };
@@ -334,6 +226,56 @@ impl Reader<'_> {
             palette,
             bit_reversed,
         })
+    }
+
+    /// `FillOrder` 2 stores the bits of each byte in reverse; libtiff
+    /// reverses them before decoding, which for uncompressed data without
+    /// a predictor is reversing the decoded bytes (`true`); other data in
+    /// that order is refused.
+    fn bit_reversed<R: Read + Seek>(&self, d: &mut Decoder<R>) -> Result<bool> {
+        match self.unsigned(d, Tag::FillOrder)?.unwrap_or(1) {
+            1 => Ok(false),
+            2 if self.unsigned(d, Tag::Compression)?.unwrap_or(1) == 1
+                && self.unsigned(d, Tag::Predictor)?.unwrap_or(1) == 1 =>
+            {
+                Ok(true)
+            }
+            2 => Err(decode_err(
+                "FillOrder 2 (bits stored least significant first) is supported for \
+                 uncompressed data without a predictor only",
+            )),
+            f => Err(decode_err(format!("FillOrder {f} is neither 1 nor 2"))),
+        }
+    }
+
+    /// A palette image's colour map (red, green and blue tables of 2^bits
+    /// entries each), after checking that its texels are one index of 1,
+    /// 2, 4, 8 or 16 bits.
+    fn palette<R: Read + Seek>(
+        &self,
+        d: &mut Decoder<R>,
+        stored_samples: usize,
+        bits: u16,
+        sample_format: u16,
+    ) -> Result<Vec<u16>> {
+        if stored_samples != 1 || !matches!(bits, 1 | 2 | 4 | 8 | 16) || sample_format != 1 {
+            return Err(decode_err(format!(
+                "a palette image of {stored_samples} samples of {bits} bits is not supported \
+                 (one index of 1, 2, 4, 8 or 16 bits is)"
+            )));
+        }
+        let map = d
+            .find_tag_unsigned_vec::<u16>(Tag::ColorMap)
+            .map_err(|e| self.err(e))?
+            .ok_or_else(|| decode_err("a palette image without a ColorMap tag"))?;
+        let want = 3usize << bits;
+        if map.len() != want {
+            return Err(decode_err(format!(
+                "the ColorMap has {} entries, a palette of {bits}-bit indices has {want}",
+                map.len()
+            )));
+        }
+        Ok(map)
     }
 
     /// Decode the directory the decoder is at: every plane of a planar
@@ -414,6 +356,99 @@ impl Reader<'_> {
             }
         };
         Texture::from_texels(dir.width, dir.height, dir.format, texels)
+    }
+}
+
+/// The colour channels a `PhotometricInterpretation` means (1 grey or
+/// palette index, 3 RGB); the interpretations parvo does not read are
+/// refused in words.
+fn colour_channels(photometric: u64, stored_samples: usize, bits: u16) -> Result<usize> {
+    match photometric {
+        1 | 3 => Ok(1),
+        2 => Ok(3),
+        // The crate inverts one WhiteIsZero channel (as libtiff
+        // and OpenImageIO read it: 0 is white).
+        0 if stored_samples == 1 && matches!(bits, 1 | 2 | 4 | 8 | 16 | 32 | 64) => Ok(1),
+        0 if stored_samples == 1 => Err(decode_err(format!(
+            "WhiteIsZero (inverted grey) TIFF of {}-bit samples is not supported (1, 2, \
+             4, 8 and 16 bits are)",
+            bits
+        ))),
+        0 => Err(decode_err(
+            "WhiteIsZero (inverted grey) TIFF with an alpha or extra channel is not \
+             supported",
+        )),
+        4 => Err(decode_err("transparency-mask TIFF is not supported")),
+        5 => Err(decode_err("CMYK TIFF is not supported")),
+        6 => Err(decode_err("YCbCr TIFF is not supported (store it as RGB)")),
+        8..=10 => Err(decode_err("CIE L*a*b* TIFF is not supported")),
+        32844 | 32845 => Err(decode_err("LogLuv (SGI) TIFF is not supported")),
+        u64::MAX => Err(decode_err(
+            "the PhotometricInterpretation tag does not hold one number",
+        )),
+        p => Err(decode_err(format!(
+            "photometric interpretation {p} is not supported"
+        ))),
+    }
+}
+
+/// The channel type samples of `sample_format` (1 unsigned, 2 signed, 3
+/// float) and `bits` load as: u8 for palette indices and sub-byte grey,
+/// u16, f16, or f32 (also for f64); the others are refused in words.
+fn channel_type(
+    sample_format: u16,
+    bits: u16,
+    stored_samples: usize,
+    palette: bool,
+) -> Result<ChannelType> {
+    Ok(match (sample_format, bits) {
+        _ if palette => ChannelType::U8,
+        (1, 1..=7) if stored_samples == 1 => ChannelType::U8,
+        (1, 8) => ChannelType::U8,
+        (1, 16) => ChannelType::U16,
+        (3, 16) => ChannelType::F16,
+        (3, 32) | (3, 64) => ChannelType::F32,
+        (1, b) if b < 8 => {
+            return Err(decode_err(format!(
+                "{b}-bit samples are supported for one grey channel, not for {stored_samples} \
+                 channels"
+            )));
+        }
+        (1, b) => {
+            return Err(decode_err(format!(
+                "{b}-bit unsigned integer samples are not supported (8 and 16 are)"
+            )));
+        }
+        (2, b) => {
+            return Err(decode_err(format!(
+                "signed {b}-bit samples are not supported"
+            )));
+        }
+        (f, b) => {
+            return Err(decode_err(format!(
+                "sample format {f} with {b} bits is not supported"
+            )));
+        }
+    })
+}
+
+/// What the first `ExtraSamples` value says the channel after the colour
+/// is: 1 associated alpha, 2 unassociated alpha, other values data;
+/// without the tag, a second or fourth channel (`has_alpha_slot`) is
+/// associated alpha, OpenImageIO's assumption, with a note saying so.
+fn extra_alpha(extra: Option<u16>, has_alpha_slot: bool) -> (AlphaMode, Option<&'static str>) {
+    match extra {
+        Some(1) => (AlphaMode::Premultiplied, None),
+        Some(2) => (AlphaMode::Straight, None),
+        Some(_) => (AlphaMode::None, None),
+        None if has_alpha_slot => (
+            AlphaMode::Premultiplied,
+            Some(
+                "no ExtraSamples tag: the last channel is taken as associated alpha, as \
+                 OpenImageIO does",
+            ),
+        ),
+        None => (AlphaMode::None, None),
     }
 }
 
