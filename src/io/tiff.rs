@@ -99,6 +99,28 @@ struct Directory {
     bit_reversed: bool,
 }
 
+impl Directory {
+    /// What level 0's tags leave to an assumption, as notes: alpha taken
+    /// without an ExtraSamples tag, a colour map rounded to 8 bits.
+    fn notes(&self, notes: &mut Vec<String>) {
+        if let Some(n) = self.alpha_note {
+            notes.push(format!(
+                "{n} ({} straight or none overrides)",
+                Setting::Alpha
+            ));
+        }
+        if let Some(map) = &self.palette
+            && map.iter().any(|&v| v % 257 != 0)
+        {
+            notes.push(
+                "palette TIFF: the colour map's 16-bit entries are rounded down to 8 bits, as \
+                 OpenImageIO reads them"
+                    .into(),
+            );
+        }
+    }
+}
+
 fn ascii_tag<R: Read + Seek>(d: &mut Decoder<R>, tag: Tag) -> Option<String> {
     match d.find_tag(tag).ok().flatten()? {
         ::tiff::decoder::ifd::Value::Ascii(s) => Some(s.trim_end_matches('\0').to_string()),
@@ -276,6 +298,51 @@ impl Reader<'_> {
             )));
         }
         Ok(map)
+    }
+
+    /// The attributes `parvo info` shows, sorted: the text tags, Pixar's
+    /// `textureformat` and `wrapmodes`, the compression and a non-default
+    /// orientation.
+    fn attributes<R: Read + Seek>(
+        &self,
+        d: &mut Decoder<R>,
+        dir: &Directory,
+        texture_format: &Option<String>,
+        wrap_text: &Option<String>,
+    ) -> Result<Vec<(String, String)>> {
+        let mut attributes: Vec<(String, String)> = Vec::new();
+        for (name, tag) in [
+            ("ImageDescription", Tag::ImageDescription),
+            ("Software", Tag::Software),
+            ("DateTime", Tag::DateTime),
+            ("Artist", Tag::Artist),
+        ] {
+            if let Some(v) = ascii_tag(d, tag) {
+                attributes.push((name.into(), v));
+            }
+        }
+        if let Some(t) = texture_format {
+            attributes.push(("textureformat".into(), t.clone()));
+        }
+        if let Some(w) = wrap_text {
+            attributes.push(("wrapmodes".into(), w.clone()));
+        }
+        if let Some(c) = self.unsigned(d, Tag::Compression)? {
+            let name = match c {
+                1 => "none".to_string(),
+                5 => "lzw".into(),
+                7 => "jpeg".into(),
+                8 | 32946 => "zip".into(),
+                32773 => "packbits".into(),
+                other => other.to_string(),
+            };
+            attributes.push(("compression".into(), name));
+        }
+        if dir.orientation != 1 {
+            attributes.push(("Orientation".into(), dir.orientation.to_string()));
+        }
+        attributes.sort();
+        Ok(attributes)
     }
 
     /// Decode the directory the decoder is at: every plane of a planar
@@ -631,27 +698,91 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     let chain = chain::walk(&mut file, len).map_err(decode_err)?;
     let l = chain.layout;
     let pages = chain.dirs.len();
-    let texture_format = chain.dirs[0].entry(tag::TEXTURE_FORMAT).is_some();
-    let mipmapped = texture_format;
-    let first = if mipmapped { 0 } else { options.subimage };
-    if first >= pages {
-        return Err(Error::InvalidOption(format!(
-            "{} {first}: the file has {pages} page{}",
-            Setting::Subimage,
-            if pages == 1 { "" } else { "s" }
-        )));
-    }
-    if mipmapped && options.subimage != 0 {
-        return Err(Error::InvalidOption(format!(
-            "{}: this TIFF is a mip-mapped texture, its directories are its levels",
-            Setting::Subimage
-        )));
-    }
-    let count = if mipmapped { pages } else { 1 };
+    // A texture: its first directory has Pixar's `textureformat` tag.
+    let mipmapped = chain.dirs[0].entry(tag::TEXTURE_FORMAT).is_some();
+    let (first, count) = directories_read(pages, mipmapped, options)?;
     for d in &chain.dirs[first..first + count] {
         chain::check_extents(&mut file, &l, d).map_err(decode_err)?;
     }
     let (view, fixes, fix_notes) = chain.repair(open()?).map_err(decode_err)?;
+    let mut notes = chain_notes(&chain, fix_notes, first, mipmapped);
+    let reader = |k: usize| Reader {
+        raw: &chain.dirs[k],
+        layout: l,
+        limits,
+    };
+    let mut d = Decoder::new(BufReader::new(view))
+        .map_err(|e| reader(0).err(e))?
+        .with_limits(decoder_limits(limits, len));
+    d.seek_to_image(first).map_err(|e| reader(first).err(e))?;
+    let r0 = reader(first);
+    let dir0 = r0.directory(&mut d, fixes[first])?;
+    let texture_format = ascii_tag(&mut d, Tag::Unknown(tag::TEXTURE_FORMAT));
+    let wrap_text = ascii_tag(&mut d, Tag::Unknown(tag::WRAP_MODES));
+    let attributes = r0.attributes(&mut d, &dir0, &texture_format, &wrap_text)?;
+    let env = environment(texture_format.as_deref());
+    if let Some(kind) = env {
+        super::environment_map(
+            "TIFF",
+            kind,
+            &format!(
+                "textureformat \"{}\", {}x{}",
+                texture_format.as_deref().unwrap_or(""),
+                dir0.width,
+                dir0.height
+            ),
+            options,
+            &mut notes,
+        )?;
+    }
+    check_levels(&dir0, count, limits)?;
+    dir0.notes(&mut notes);
+    let mut levels = vec![r0.texture(&mut d, &dir0)?];
+    let mut rounding = Rounding::Down;
+    for (k, &fix) in fixes.iter().enumerate().take(count).skip(1) {
+        d.seek_to_image(k).map_err(|e| reader(k).err(e))?;
+        let rk = reader(k);
+        let dir = rk.directory(&mut d, fix)?;
+        if k == 1 {
+            rounding = level_rounding(&dir0, &dir).unwrap_or(rounding);
+        }
+        let want = crate::mip::level_size(dir0.width, dir0.height, k as u32, rounding);
+        if (dir.width, dir.height) != want || dir.format != dir0.format {
+            return Err(decode_err(format!(
+                "mip level {k} is {}x{} {}, level 0 implies {}x{} {}",
+                dir.width, dir.height, dir.format, want.0, want.1, dir0.format
+            )));
+        }
+        levels.push(rk.texture(&mut d, &dir)?);
+    }
+    if dir0.orientation != 1 {
+        apply_orientation(&mut levels, dir0.orientation, options, &mut notes)?;
+    }
+    let format = levels[0].format();
+    let mut info = SourceInfo::new(FileFormat::Tiff, &format);
+    info.own_mips = levels.len() > 1;
+    info.rounding = rounding;
+    info.wrap = super::recorded_wrap(wrap_text.as_deref(), &mut notes);
+    info.tile = dir0.tile;
+    info.attributes = attributes;
+    info.environment = env;
+    info.notes = notes;
+    // TIFF names no transfer parvo reads: its values are taken as they
+    // are (linear), as OpenImageIO reads them, and that is an assumption.
+    info.color_stated = false;
+    Ok(Loaded { levels, info })
+}
+
+/// The notes of walking and repairing the chain of directories: of the
+/// page read only, unless all are read (a mip-mapped texture); a note
+/// that the file has other pages.
+fn chain_notes(
+    chain: &chain::Chain,
+    fix_notes: Vec<String>,
+    first: usize,
+    mipmapped: bool,
+) -> Vec<String> {
+    let pages = chain.dirs.len();
     let mut notes = Vec::new();
     if !mipmapped && pages > 1 {
         notes.push(format!(
@@ -672,72 +803,49 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
                 .map(|n| n.trim_start_matches(&prefix).to_string()),
         );
     }
-    let reader = |k: usize| Reader {
-        raw: &chain.dirs[k],
-        layout: l,
-        limits,
-    };
+    notes
+}
+
+/// Which of `pages` directories are read, as (first, count): all of a
+/// mip-mapped texture, else the one page `options.subimage` picks.
+fn directories_read(
+    pages: usize,
+    mipmapped: bool,
+    options: &LoadOptions,
+) -> Result<(usize, usize)> {
+    let first = if mipmapped { 0 } else { options.subimage };
+    if first >= pages {
+        return Err(Error::InvalidOption(format!(
+            "{} {first}: the file has {pages} page{}",
+            Setting::Subimage,
+            if pages == 1 { "" } else { "s" }
+        )));
+    }
+    if mipmapped && options.subimage != 0 {
+        return Err(Error::InvalidOption(format!(
+            "{}: this TIFF is a mip-mapped texture, its directories are its levels",
+            Setting::Subimage
+        )));
+    }
+    Ok((first, if mipmapped { pages } else { 1 }))
+}
+
+/// The `tiff` crate's limits: its decoding buffers held to the allocation
+/// limit; a tag's values to the file's length (at least the crate's own
+/// default, at most the allocation limit).
+fn decoder_limits(limits: &Limits, len: u64) -> ::tiff::decoder::Limits {
     let mut tl = ::tiff::decoder::Limits::default();
     tl.decoding_buffer_size = usize::try_from(limits.max_alloc).unwrap_or(usize::MAX);
     tl.intermediate_buffer_size = tl.decoding_buffer_size;
     tl.ifd_value_size =
         usize::try_from(len.min(limits.max_alloc).max(CRATE_TAG_LIMIT)).unwrap_or(usize::MAX);
-    let mut d = Decoder::new(BufReader::new(view))
-        .map_err(|e| reader(0).err(e))?
-        .with_limits(tl);
-    d.seek_to_image(first).map_err(|e| reader(first).err(e))?;
-    let r0 = reader(first);
-    let dir0 = r0.directory(&mut d, fixes[first])?;
-    let texture_format = ascii_tag(&mut d, Tag::Unknown(tag::TEXTURE_FORMAT));
-    let wrap_text = ascii_tag(&mut d, Tag::Unknown(tag::WRAP_MODES));
-    let mut attributes: Vec<(String, String)> = Vec::new();
-    for (name, tag) in [
-        ("ImageDescription", Tag::ImageDescription),
-        ("Software", Tag::Software),
-        ("DateTime", Tag::DateTime),
-        ("Artist", Tag::Artist),
-    ] {
-        if let Some(v) = ascii_tag(&mut d, tag) {
-            attributes.push((name.into(), v));
-        }
-    }
-    if let Some(t) = &texture_format {
-        attributes.push(("textureformat".into(), t.clone()));
-    }
-    if let Some(w) = &wrap_text {
-        attributes.push(("wrapmodes".into(), w.clone()));
-    }
-    if let Some(c) = r0.unsigned(&mut d, Tag::Compression)? {
-        let name = match c {
-            1 => "none".to_string(),
-            5 => "lzw".into(),
-            7 => "jpeg".into(),
-            8 | 32946 => "zip".into(),
-            32773 => "packbits".into(),
-            other => other.to_string(),
-        };
-        attributes.push(("compression".into(), name));
-    }
-    if dir0.orientation != 1 {
-        attributes.push(("Orientation".into(), dir0.orientation.to_string()));
-    }
-    attributes.sort();
-    let env = environment(texture_format.as_deref());
-    if let Some(kind) = env {
-        super::environment_map(
-            "TIFF",
-            kind,
-            &format!(
-                "textureformat \"{}\", {}x{}",
-                texture_format.as_deref().unwrap_or(""),
-                dir0.width,
-                dir0.height
-            ),
-            options,
-            &mut notes,
-        )?;
-    }
-    // Declared sizes of every level read, checked before decoding.
+    tl
+}
+
+/// The declared sizes of every level read, checked before decoding: no
+/// more directories than a mip chain of level 0 has, level 0 (twice, with
+/// the levels after it) within `limits`.
+fn check_levels(dir0: &Directory, count: usize, limits: &Limits) -> Result<()> {
     let full = crate::mip::level_count(dir0.width, dir0.height, Rounding::Down, None) as usize;
     let up = crate::mip::level_count(dir0.width, dir0.height, Rounding::Up, None) as usize;
     if count > full.max(up) {
@@ -753,77 +861,48 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
         (dir0.width as u64 * dir0.height as u64)
             .saturating_mul(texel)
             .saturating_mul(if count > 1 { 2 } else { 1 }),
-    )?;
-    if let Some(n) = dir0.alpha_note {
+    )
+}
+
+/// The rounding a mip chain's level 1 shows (`None` when its size is
+/// neither level 0 halved down nor up; the size check then refuses it).
+fn level_rounding(dir0: &Directory, dir1: &Directory) -> Option<Rounding> {
+    let up_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Up);
+    let down_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Down);
+    if (dir1.width, dir1.height) == down_size {
+        Some(Rounding::Down)
+    } else if (dir1.width, dir1.height) == up_size {
+        Some(Rounding::Up)
+    } else {
+        None
+    }
+}
+
+/// The TIFF `Orientation` (274) applied to every level, unless turned off;
+/// a note says which.
+fn apply_orientation(
+    levels: &mut [Texture],
+    orientation: u16,
+    options: &LoadOptions,
+    notes: &mut Vec<String>,
+) -> Result<()> {
+    if options.auto_orient {
+        for l in levels.iter_mut() {
+            *l = super::orient(l, orientation)?;
+        }
         notes.push(format!(
-            "{n} ({} straight or none overrides)",
-            Setting::Alpha
+            "TIFF orientation {} applied ({} keeps the stored order)",
+            orientation,
+            Setting::NoAutoOrient
+        ));
+    } else {
+        notes.push(format!(
+            "TIFF orientation {} not applied ({})",
+            orientation,
+            Setting::NoAutoOrient
         ));
     }
-    if let Some(map) = &dir0.palette
-        && map.iter().any(|&v| v % 257 != 0)
-    {
-        notes.push(
-            "palette TIFF: the colour map's 16-bit entries are rounded down to 8 bits, as \
-             OpenImageIO reads them"
-                .into(),
-        );
-    }
-    let mut levels = vec![r0.texture(&mut d, &dir0)?];
-    let mut rounding = Rounding::Down;
-    for (k, &fix) in fixes.iter().enumerate().take(count).skip(1) {
-        d.seek_to_image(k).map_err(|e| reader(k).err(e))?;
-        let rk = reader(k);
-        let dir = rk.directory(&mut d, fix)?;
-        if k == 1 {
-            let up_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Up);
-            let down_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Down);
-            if (dir.width, dir.height) == down_size {
-                rounding = Rounding::Down;
-            } else if (dir.width, dir.height) == up_size {
-                rounding = Rounding::Up;
-            }
-        }
-        let want = crate::mip::level_size(dir0.width, dir0.height, k as u32, rounding);
-        if (dir.width, dir.height) != want || dir.format != dir0.format {
-            return Err(decode_err(format!(
-                "mip level {k} is {}x{} {}, level 0 implies {}x{} {}",
-                dir.width, dir.height, dir.format, want.0, want.1, dir0.format
-            )));
-        }
-        levels.push(rk.texture(&mut d, &dir)?);
-    }
-    if dir0.orientation != 1 {
-        if options.auto_orient {
-            for l in &mut levels {
-                *l = super::orient(l, dir0.orientation)?;
-            }
-            notes.push(format!(
-                "TIFF orientation {} applied ({} keeps the stored order)",
-                dir0.orientation,
-                Setting::NoAutoOrient
-            ));
-        } else {
-            notes.push(format!(
-                "TIFF orientation {} not applied ({})",
-                dir0.orientation,
-                Setting::NoAutoOrient
-            ));
-        }
-    }
-    let format = levels[0].format();
-    let mut info = SourceInfo::new(FileFormat::Tiff, &format);
-    info.own_mips = levels.len() > 1;
-    info.rounding = rounding;
-    info.wrap = super::recorded_wrap(wrap_text.as_deref(), &mut notes);
-    info.tile = dir0.tile;
-    info.attributes = attributes;
-    info.environment = env;
-    info.notes = notes;
-    // TIFF names no transfer parvo reads: its values are taken as they
-    // are (linear), as OpenImageIO reads them, and that is an assumption.
-    info.color_stated = false;
-    Ok(Loaded { levels, info })
+    Ok(())
 }
 
 /// TIFF in the container table (read only): strips and tiles, chunky and
