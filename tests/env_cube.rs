@@ -177,7 +177,7 @@ fn texels_past_an_edge_are_the_neighbour_faces_edge_texels() {
             .collect();
         let c = CubeSampler::new(&faces, SamplerOptions::bilinear()).unwrap();
         let n_i = n as i64;
-        for f in 0..6 {
+        for (f, name) in FACE_NAMES.iter().enumerate() {
             for k in 0..n_i {
                 // One step past each of the four edges, along the edge.
                 for (i, j) in [(-1, k), (n_i, k), (k, -1), (k, n_i)] {
@@ -185,12 +185,8 @@ fn texels_past_an_edge_are_the_neighbour_faces_edge_texels() {
                     // The texel just past the edge, a hair outside the
                     // face, is the nearest texel to the direction through
                     // the edge point itself (the same row along the edge).
-                    let s = ((i.clamp(0, n_i - 1) as f64 + 0.5) / n as f64)
-                        .min(1.0 - 1e-9)
-                        .max(1e-9);
-                    let t = ((j.clamp(0, n_i - 1) as f64 + 0.5) / n as f64)
-                        .min(1.0 - 1e-9)
-                        .max(1e-9);
+                    let s = ((i.clamp(0, n_i - 1) as f64 + 0.5) / n as f64).clamp(1e-9, 1.0 - 1e-9);
+                    let t = ((j.clamp(0, n_i - 1) as f64 + 0.5) / n as f64).clamp(1e-9, 1.0 - 1e-9);
                     let (s, t) = match (i, j) {
                         (-1, _) => (-1e-6, t),
                         (x, _) if x == n_i => (1.0 + 1e-6, t),
@@ -202,8 +198,7 @@ fn texels_past_an_edge_are_the_neighbour_faces_edge_texels() {
                     assert_eq!(
                         got,
                         [want.0 as f32, want.1 as f32, want.2 as f32, 1.0],
-                        "n {n}, face {}, texel ({i}, {j})",
-                        FACE_NAMES[f]
+                        "n {n}, face {name}, texel ({i}, {j})"
                     );
                 }
             }

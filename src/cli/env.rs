@@ -9,6 +9,7 @@ use anyhow::{Context, Result, anyhow};
 use parvo::MipOptions;
 use parvo::env::cube::{build_faces, faces_from_strip};
 use parvo::env::{CubeSampler, DirQuery, LatLongSampler, latlong};
+use parvo::io::Environment;
 use parvo::sample::SamplerOptions;
 
 use super::texture::TextureArgs;
@@ -24,7 +25,7 @@ pub enum EnvArg {
 
 /// A direction sampler of either kind.
 enum EnvSampler {
-    LatLong(LatLongSampler),
+    LatLong(Box<LatLongSampler>),
     Cube(CubeSampler),
 }
 
@@ -37,20 +38,31 @@ impl EnvSampler {
     }
 }
 
-/// Build the sampler `env` asks for from `texture`; the texture's channel
-/// count.
+/// Build the sampler for `texture`, read as `env` or, without it, as the
+/// environment the file records; and the texture's channel count.
 fn sampler(
     read: &TextureArgs,
     texture: &str,
-    env: EnvArg,
+    env: Option<EnvArg>,
     options: SamplerOptions,
 ) -> Result<(EnvSampler, usize)> {
+    let loaded = read.load_environment(texture)?;
+    let channels = loaded.base().format().channels as usize;
+    let env = match (env, loaded.info.environment) {
+        (Some(e), _) => e,
+        (None, Some(Environment::LatLong)) => EnvArg::Latlong,
+        (None, Some(Environment::Cube)) => EnvArg::Cube,
+        (None, None) => {
+            return Err(anyhow!(
+                "`{texture}` records no environment (no OpenEXR envmap, no maketx \
+                 textureformat): say what it holds with --env latlong or --env cube"
+            ));
+        }
+    };
     match env {
         EnvArg::Latlong => {
             // A file's own levels are kept; otherwise the levels are built
             // as a lat-long map needs them (rows weighted by solid angle).
-            let loaded = read.load(texture)?;
-            let channels = loaded.base().format().channels as usize;
             let chain = if loaded.levels.len() > 1 {
                 loaded
                     .into_chain()
@@ -60,13 +72,13 @@ fn sampler(
                 latlong::build_chain(loaded.into_base())?
             };
             Ok((
-                EnvSampler::LatLong(LatLongSampler::new(&chain, options)?),
+                EnvSampler::LatLong(Box::new(LatLongSampler::new(&chain, options)?)),
                 channels,
             ))
         }
         EnvArg::Cube => {
-            let loaded = read.load(texture)?;
-            let channels = loaded.base().format().channels as usize;
+            // The faces of level 0, each mip-mapped on its own (a strip's
+            // own levels would mix faces once they are 1 texel high).
             let faces = faces_from_strip(&loaded.into_base())
                 .with_context(|| format!("cannot read `{texture}` as a cube map"))?;
             let chains = build_faces(faces, &MipOptions::default())?;
@@ -78,11 +90,12 @@ fn sampler(
     }
 }
 
-/// Run direction queries from stdin against `texture` read as `env`.
+/// Run direction queries from stdin against `texture` read as `env` (or
+/// as the environment the file records).
 pub fn run(
     read: &TextureArgs,
     texture: &str,
-    env: EnvArg,
+    env: Option<EnvArg>,
     options: SamplerOptions,
     input: impl BufRead,
     mut out: impl Write,

@@ -130,14 +130,14 @@ pub struct SampleArgs {
         for fixed-point depth."
     )]
     compare: Option<CompareOp>,
-    /// Queries are directions: `x y z dxdx dydx dzdx dxdy dydy dzdy` per line (needs --env).
+    /// Queries are directions: `x y z dxdx dydx dzdx dxdy dydy dzdy` per line.
     #[arg(
         long,
-        requires = "env",
         conflicts_with_all = ["gather", "compare", "level", "bias"],
         long_help = "Each query line is a direction and its screen derivatives, `x y z dxdx dydx \
         dzdx dxdy dydy dzdy` (as dFdx/dFdy of a reflection vector give them), looked up in the \
-        environment --env says the texture holds. Cube maps are filtered seamlessly across face \
+        environment the file records (maketx's and OpenEXR's lat-long and cube-face maps) or \
+        --env says it holds. Cube maps are filtered seamlessly across face \
         edges (GL's ARB_seamless_cube_map, every filter); lat-long maps as OpenImageIO's \
         environment() filters them."
     )]
@@ -238,7 +238,8 @@ pub fn run(args: SampleArgs) -> Result<ExitCode> {
         eprintln!("parvo: {}", super::words(&e));
         return Ok(ExitCode::from(2));
     }
-    if let (true, Some(env)) = (args.direction, args.env) {
+    if args.direction {
+        let env = args.env;
         let out = BufWriter::with_capacity(1 << 16, io::stdout().lock());
         super::env::run(
             &args.read,

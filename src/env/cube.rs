@@ -10,7 +10,7 @@
 //! derivatives of `(s, t)` follow from the direction's derivatives by the
 //! quotient rule (GL's equations 8.9–8.10), taken on the face of the
 //! centre direction. λ, the anisotropy and the mip levels are then those
-//! of a 2-D texture the size of a face ([`crate::sample::footprint`]).
+//! of a 2-D texture the size of a face ([`mod@crate::sample::footprint`]).
 //!
 //! # Seamless texels
 //! A filter reads texel `(i, j)` of face `f` at level `k` even when `i` or

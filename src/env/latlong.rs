@@ -30,6 +30,12 @@
 //! - Each level is read with the sampler's minification filter (OpenImageIO
 //!   has one interpolation mode for all levels): bilinear at
 //!   `(s·w − ½, t·h − ½)` or the nearest texel.
+//! - Near a pole, bilinear reads of the small levels fade to the pole's
+//!   colour (the mean of the level's first or last row), so the coarse
+//!   levels converge to one colour at the pole: with `tt = t·h`, weight
+//!   `(1 − tt)²` for `tt < 1` and `frac(tt)²` for `tt > h − 1`. OpenImageIO
+//!   does this on levels that fit in one tile of the file; parvo on levels
+//!   of at most [`POLE_FADE_SIZE`] texels each way (maketx's tile size).
 //! - The LOD bias scales the filter width by 2^bias (OpenImageIO has no
 //!   bias here; at 0 they agree).
 //!
@@ -49,6 +55,10 @@ use crate::texture::Texture;
 use crate::wrap::{Wrap, WrapMode};
 
 use super::DirQuery;
+
+/// Levels at most this many texels wide and high fade to the pole colour
+/// near the poles (module docs).
+pub const POLE_FADE_SIZE: u32 = 64;
 
 /// `(s, t)` of a unit direction (y up, module docs).
 pub fn direction_to_st(d: [f64; 3]) -> (f64, f64) {
@@ -75,6 +85,8 @@ pub struct LatLongSampler {
     options: SamplerOptions,
     /// For EWA and summed-area tables: the 2-D sampler over (s, t).
     plane: Option<Sampler>,
+    /// Per level: the mean of its first and of its last row.
+    poles: Vec<[[f32; 4]; 2]>,
 }
 
 impl LatLongSampler {
@@ -99,10 +111,26 @@ impl LatLongSampler {
         if chain.levels()[0].height() == 0 {
             return Err(Error::InvalidOption("an empty lat-long map".into()));
         }
+        let poles = (0..linear.len())
+            .map(|k| {
+                let (w, h) = linear.level_size(k).unwrap_or((1, 1));
+                [0, h - 1].map(|row| {
+                    let mut acc = [0f64; 4];
+                    for x in 0..w {
+                        let t = linear.texel(k, x, row).unwrap_or([0.0; 4]);
+                        for c in 0..4 {
+                            acc[c] += t[c] as f64;
+                        }
+                    }
+                    acc.map(|a| (a / w as f64) as f32)
+                })
+            })
+            .collect();
         Ok(LatLongSampler {
             chain: linear,
             options,
             plane,
+            poles,
         })
     }
 
@@ -130,12 +158,22 @@ impl LatLongSampler {
         let r = unit(d);
         let rx = unit(add(d, dx));
         let ry = unit(add(d, dy));
-        let xf = dot(r, rx).clamp(-1.0, 1.0).acos().max(1e-8);
-        let yf = dot(r, ry).clamp(-1.0, 1.0).acos().max(1e-8);
+        // The footprint's angles, aspect and probe count in f32 as
+        // OpenImageIO computes them: the probe count and the levels are
+        // steps, and f64 would move a few of their thresholds.
+        let r32 = unit32(d);
+        let angle = |e: [f64; 3]| {
+            let e = unit32(add(d, e));
+            (r32[0] * e[0] + r32[1] * e[1] + r32[2] * e[2])
+                .clamp(-1.0, 1.0)
+                .acos()
+                .max(1e-8)
+        };
+        let (xf, yf) = (angle(dx), angle(dy));
         let (rmajor, mut major, mut minor) = if xf >= yf { (rx, xf, yf) } else { (ry, yf, xf) };
         let o = &self.options;
         let (width, n) = if o.max_aniso > 1 {
-            let limit = o.max_aniso as f64;
+            let limit = o.max_aniso as f32;
             let aspect = (major / minor).clamp(1.0, 1e6);
             let aspect = if aspect > limit {
                 major = 0.5 * (major + minor * limit);
@@ -144,9 +182,9 @@ impl LatLongSampler {
             } else {
                 aspect
             };
-            (minor, ((aspect - 0.25).ceil() as u32).max(1))
+            (minor as f64, ((aspect - 0.25).ceil() as u32).max(1))
         } else {
-            (major, 1)
+            (major as f64, 1)
         };
         let width = width * (o.lod_bias as f64).exp2();
         let (hi, lo, blend) = self.levels(width);
@@ -213,7 +251,20 @@ impl LatLongSampler {
         let (i, j) = (x0 as i64, y0 as i64);
         let top = mix(texel(i, j), texel(i + 1, j), a);
         let bottom = mix(texel(i, j + 1), texel(i + 1, j + 1), a);
-        mix(top, bottom, b)
+        let v = mix(top, bottom, b);
+        if w > POLE_FADE_SIZE as i64 || h > POLE_FADE_SIZE as i64 {
+            return v;
+        }
+        let tt = t * h as f64;
+        let (pole, colour) = if tt < 1.0 {
+            (1.0 - tt, self.poles[k][0])
+        } else if tt > (h - 1) as f64 {
+            (tt - tt.floor(), self.poles[k][1])
+        } else {
+            return v;
+        };
+        let p = pole.clamp(0.0, 1.0);
+        mix(v, colour, (p * p) as f32)
     }
 
     /// The supersampled reference (module docs).
@@ -276,6 +327,17 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// its `(s, t)` then reads 0 where NaN).
 fn unit(a: [f64; 3]) -> [f64; 3] {
     let l = dot(a, a).sqrt();
+    if l > 0.0 && l.is_finite() {
+        a.map(|c| c / l)
+    } else {
+        a
+    }
+}
+
+/// `a` scaled to unit length in `f32` (as OpenImageIO normalises).
+fn unit32(a: [f64; 3]) -> [f32; 3] {
+    let a = a.map(|c| c as f32);
+    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
     if l > 0.0 && l.is_finite() {
         a.map(|c| c / l)
     } else {

@@ -179,7 +179,7 @@ pub fn specular(faces: &[MipChain], lobe: Lobe, samples: u32) -> Result<Vec<MipC
         ));
     }
     let texel_angle = 4.0 * PI / (6.0 * size as f64 * size as f64);
-    let mut out: Vec<Vec<Texture>> = vec![Vec::with_capacity(levels); 6];
+    let mut out: Vec<Vec<Texture>> = (0..6).map(|_| Vec::with_capacity(levels)).collect();
     for k in 0..levels {
         let n = (size >> k).max(1);
         let a = alpha(k, levels);
