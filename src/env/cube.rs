@@ -373,29 +373,11 @@ impl CubeSampler {
     /// directions spread over the pixel's footprint `dir ± ddx/2 ± ddy/2`
     /// (the 2-D reference's grid, in direction space).
     fn supersample(&self, q: &DirQuery) -> [f32; 4] {
-        let n = self.options.supersample.clamp(1, 64);
-        let inv = 1.0 / n as f64;
-        let (d, dx, dy) = (
-            q.dir.map(f64::from),
-            q.ddx.map(f64::from),
-            q.ddy.map(f64::from),
-        );
-        let mut acc = [0.0f64; 4];
-        for j in 0..n {
-            let ty = (j as f64 + 0.5) * inv - 0.5;
-            for i in 0..n {
-                let tx = (i as f64 + 0.5) * inv - 0.5;
-                let p: [f64; 3] = std::array::from_fn(|c| d[c] + tx * dx[c] + ty * dy[c]);
-                let f = select_face(p);
-                let (s, t) = face_st(f, p);
-                let v = self.bilinear(f, 0, s, t);
-                for c in 0..4 {
-                    acc[c] += v[c] as f64;
-                }
-            }
-        }
-        let s = 1.0 / (n * n) as f64;
-        acc.map(|x| (x * s) as f32)
+        super::grid_average(q, self.options.supersample, |p| {
+            let f = select_face(p);
+            let (s, t) = face_st(f, p);
+            self.bilinear(f, 0, s, t)
+        })
     }
 
     /// Level count minus one (the last level's index).

@@ -148,7 +148,7 @@ impl LatLongSampler {
             return p.sample(&st_query(d, dx, dy));
         }
         if self.options.method == Method::Supersample {
-            return self.supersample(d, dx, dy);
+            return self.supersample(q);
         }
         self.environment(d, dx, dy)
     }
@@ -268,24 +268,11 @@ impl LatLongSampler {
     }
 
     /// The supersampled reference (module docs).
-    fn supersample(&self, d: [f64; 3], dx: [f64; 3], dy: [f64; 3]) -> [f32; 4] {
-        let n = self.options.supersample.clamp(1, 64);
-        let inv = 1.0 / n as f64;
-        let mut acc = [0.0f64; 4];
-        for j in 0..n {
-            let ty = (j as f64 + 0.5) * inv - 0.5;
-            for i in 0..n {
-                let tx = (i as f64 + 0.5) * inv - 0.5;
-                let p: [f64; 3] = std::array::from_fn(|c| d[c] + tx * dx[c] + ty * dy[c]);
-                let (s, t) = direction_to_st(unit(p));
-                let v = self.read(TexelFilter::Linear, 0, s, t);
-                for c in 0..4 {
-                    acc[c] += v[c] as f64;
-                }
-            }
-        }
-        let s = 1.0 / (n * n) as f64;
-        acc.map(|x| (x * s) as f32)
+    fn supersample(&self, q: &DirQuery) -> [f32; 4] {
+        super::grid_average(q, self.options.supersample, |p| {
+            let (s, t) = direction_to_st(unit(p));
+            self.read(TexelFilter::Linear, 0, s, t)
+        })
     }
 }
 

@@ -111,6 +111,37 @@ impl DirQuery {
     }
 }
 
+/// The supersampled reference by direction, shared by the cube and
+/// lat-long samplers: the mean of `lookup` at `n × n` directions over the
+/// footprint `dir ± ddx/2 ± ddy/2`, one at the centre of each cell of the
+/// 2-D reference's grid (summed in `f64`).
+pub(crate) fn grid_average(
+    q: &DirQuery,
+    n: u32,
+    mut lookup: impl FnMut([f64; 3]) -> [f32; 4],
+) -> [f32; 4] {
+    let n = n.clamp(1, 64);
+    let inv = 1.0 / n as f64;
+    let (d, dx, dy) = (
+        q.dir.map(f64::from),
+        q.ddx.map(f64::from),
+        q.ddy.map(f64::from),
+    );
+    let mut acc = [0.0f64; 4];
+    for j in 0..n {
+        let ty = (j as f64 + 0.5) * inv - 0.5;
+        for i in 0..n {
+            let tx = (i as f64 + 0.5) * inv - 0.5;
+            let v = lookup(std::array::from_fn(|c| d[c] + tx * dx[c] + ty * dy[c]));
+            for c in 0..4 {
+                acc[c] += v[c] as f64;
+            }
+        }
+    }
+    let s = 1.0 / (n * n) as f64;
+    acc.map(|x| (x * s) as f32)
+}
+
 /// A 2-D texture array: one sampler per layer, sharing options.
 #[derive(Clone, Debug)]
 pub struct ArraySampler {
