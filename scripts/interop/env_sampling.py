@@ -21,6 +21,10 @@
    within 1e-3 (the issue's bar): once on parvo's own chain (built from the
    image, rows weighted by solid angle as maketx weights them) and once on
    maketx's .tx read by parvo (identical texels: the lookup alone).
+3. parvo's OpenEXR environments (`parvo mip --env latlong|cube`): OpenImageIO
+   reads them with their type (`textureformat` and `envmap` as maketx
+   --envlatl / --envcube write them on the same input), and environment()
+   on parvo's lat-long file equals environment() on maketx's within 1e-3.
 """
 import math
 import subprocess
@@ -207,9 +211,69 @@ def latlong_checks(parvo, venv, work):
                      else f"; worst {q[worst].tolist()}: parvo {got[worst]}, OIIO {want[worst]}"))
 
 
+def header_of(path):
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        return None
+    spec = inp.spec()
+    out = {
+        "textureformat": spec.get_string_attribute("textureformat"),
+        "envmap": spec.getattribute("envmap"),
+        "size": (spec.width, spec.height),
+        "levels": 0,
+    }
+    while inp.seek_subimage(0, out["levels"]):
+        out["levels"] += 1
+    inp.close()
+    return out
+
+
+def exr_environment_checks(parvo, venv, work):
+    work = Path(work)
+    rng = np.random.default_rng(5)
+    ll = rng.uniform(0, 1, (32, 64, 3)).astype(np.float32)
+    strip = rng.uniform(0, 1, (6 * 16, 16, 3)).astype(np.float32)
+    oiio_write(str(work / "env_ll.exr"), ll, "float")
+    oiio_write(str(work / "env_strip.exr"), strip, "float")
+    for env, src, flag in [("latlong", "env_ll.exr", "--envlatl"), ("cube", "env_strip.exr", "--envcube")]:
+        mine, theirs = work / f"parvo_{env}.exr", work / f"maketx_{env}.tx"
+        r = subprocess.run([parvo, "mip", str(work / src), "--env", env, "--type", "f32",
+                            "-o", str(mine)], capture_output=True, text=True)
+        if not check(r.returncode == 0, f"parvo mip --env {env} writes an OpenEXR environment",
+                     r.stderr.strip()[:300]):
+            continue
+        r = subprocess.run([str(Path(venv) / "maketx"), flag, str(work / src), "-o", str(theirs)],
+                           capture_output=True, text=True)
+        if not check(r.returncode == 0, f"maketx {flag}", r.stderr.strip()[:200]):
+            continue
+        a, b = header_of(mine), header_of(theirs)
+        same = (a is not None and b is not None and a["textureformat"] == b["textureformat"]
+                and a["envmap"] == b["envmap"] and a["size"] == b["size"])
+        check(same, f"OpenImageIO reads parvo's {env} OpenEXR with the type maketx {flag} gives",
+              f"parvo {a}, maketx {b}")
+    # environment() on both lat-long files.
+    ts = oiio.TextureSystem()
+    opt = oiio.TextureOpt()
+    opt.interpmode = oiio.InterpMode.Bilinear
+    opt.mipmode = oiio.MipMode.Trilinear
+    n = 1000
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    width = 2.0 ** rng.uniform(-8, -1, n)
+    dx = rng.normal(size=(n, 3)) * width[:, None]
+    dy = rng.normal(size=(n, 3)) * width[:, None]
+    look = lambda f: np.array([ts.environment(str(work / f), opt, tuple(d[i]), tuple(dx[i]), tuple(dy[i]), 3)
+                               for i in range(n)], dtype=np.float32)
+    if (work / "parvo_latlong.exr").exists() and (work / "maketx_latlong.tx").exists():
+        diff = np.abs(look("parvo_latlong.exr") - look("maketx_latlong.tx")).max()
+        check(bool(diff <= 1e-3), "OpenImageIO environment() on parvo's lat-long file equals it on maketx's",
+              f"{n} directions, trilinear, max |diff| {diff:.2e}")
+
+
 def main():
     parvo, venv, work = args()
     latlong_checks(parvo, venv, work)
+    exr_environment_checks(parvo, venv, work)
     gl = gl_setup()
     if gl is not None:
         cube_checks(parvo, work, gl)

@@ -290,6 +290,25 @@ for i, entry in enumerate(entries):
     shutil.rmtree(outdir, ignore_errors=True)
     outdir.mkdir(parents=True)
 
+    if entry["expect"] == "kind":
+        # A cube map, an array or an environment: `parvo info` names its
+        # kind and `parvo mip` writes a file of the same kind.
+        want = entry["kind"]
+        rc, out, err = run("parvo info", parvo, "info", "--json", f)
+        got = json.loads(out).get("kind") if rc == 0 else None
+        check(got == want, f"{name}: parvo info reads it as a {want}",
+              f"exit {rc}, kind {got}; {lines(err)[-1] if lines(err) else ''}")
+        target = outdir / ("l." + entry.get("out", "ktx2"))
+        rc, out, err = run("parvo mip", parvo, "mip", f, *opts, "-o", target)
+        kept = None
+        if rc == 0:
+            rc2, out2, _ = run("parvo info", parvo, "info", "--json", target)
+            kept = json.loads(out2).get("kind") if rc2 == 0 else None
+        check(rc == 0 and kept == want, f"{name}: parvo mip keeps it a {want} ({target.suffix})",
+              f"exit {rc}, kind {kept}; {lines(err)[-1] if lines(err) else ''}")
+        seen[f] = True
+        continue
+
     if entry["expect"] == "refuse":
         pattern = entry["refuse"]
         if f not in seen:

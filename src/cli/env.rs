@@ -8,7 +8,7 @@ use std::io::{self, BufRead, Write};
 use anyhow::{Context, Result, anyhow};
 use parvo::MipOptions;
 use parvo::env::cube::{build_faces, faces_from_strip};
-use parvo::env::{CubeSampler, DirQuery, LatLongSampler, latlong};
+use parvo::env::{CubeSampler, DirQuery, Kind, LatLongSampler, latlong};
 use parvo::io::Environment;
 use parvo::sample::SamplerOptions;
 
@@ -48,6 +48,25 @@ fn sampler(
 ) -> Result<(EnvSampler, usize)> {
     let loaded = read.load_environment(texture)?;
     let channels = loaded.base().format().channels as usize;
+    match loaded.info.kind {
+        Kind::Cube if env != Some(EnvArg::Latlong) => {
+            // A KTX2 or DDS cube map: its faces, with their own levels.
+            let chains = loaded
+                .into_image_chains()
+                .with_context(|| format!("cannot read texture `{texture}`"))?;
+            return Ok((
+                EnvSampler::Cube(CubeSampler::new(&chains, options)?),
+                channels,
+            ));
+        }
+        Kind::Plain | Kind::LatLong => {}
+        other => {
+            return Err(anyhow!(
+                "`{texture}` is a {}: direction lookups read one cube map or a lat-long map",
+                other.describe()
+            ));
+        }
+    }
     let env = match (env, loaded.info.environment) {
         (Some(e), _) => e,
         (None, Some(Environment::LatLong)) => EnvArg::Latlong,

@@ -6,6 +6,7 @@
 
 use std::process::ExitCode;
 
+use parvo::env::Kind;
 use parvo::io::{self, Limits, Loaded};
 
 /// Arguments of `parvo info`.
@@ -129,6 +130,7 @@ fn text(file: &str, l: &Loaded) -> String {
             String::new()
         }
     );
+    let _ = writeln!(s, "  kind:       {}", kind_text(i));
     let _ = writeln!(s, "  levels:     {}", l.levels.len());
     for (k, t) in l.levels.iter().enumerate() {
         let m: Vec<String> = means(t).iter().map(|v| format!("{v:.4}")).collect();
@@ -159,6 +161,30 @@ fn text(file: &str, l: &Loaded) -> String {
     s
 }
 
+/// The image kind in words: what the container says (array, cube map)
+/// or the environment the file records (OpenEXR, maketx).
+fn kind_text(i: &io::SourceInfo) -> String {
+    match i.environment {
+        Some(io::Environment::LatLong) => Kind::LatLong.describe(),
+        Some(io::Environment::Cube) => {
+            "cube map (OpenEXR strip: six faces stacked, +x -x +y -y +z -z from the top)".into()
+        }
+        None => i.kind.describe(),
+    }
+}
+
+/// The image kind as `--json` names it: `2d`, `array`, `cube`,
+/// `cube-array`, `latlong`.
+fn kind_id(i: &io::SourceInfo) -> &'static str {
+    match (i.environment, i.kind) {
+        (Some(io::Environment::LatLong), _) | (None, Kind::LatLong) => "latlong",
+        (Some(io::Environment::Cube), _) | (None, Kind::Cube) => "cube",
+        (None, Kind::Array { .. }) => "array",
+        (None, Kind::CubeArray { .. }) => "cube-array",
+        (None, Kind::Plain) => "2d",
+    }
+}
+
 fn json(file: &str, l: &Loaded) -> String {
     let b = l.base();
     let f = b.format();
@@ -176,6 +202,8 @@ fn json(file: &str, l: &Loaded) -> String {
         "alpha": f.alpha.to_string(),
         "tile": i.tile.map(|(w, h)| [w, h]),
         "rounding": i.rounding.to_string(),
+        "kind": kind_id(i),
+        "images": 1 + l.images.len(),
         "levels": l.levels.iter().map(|t| serde_json::json!({
             "width": t.width(),
             "height": t.height(),

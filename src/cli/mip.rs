@@ -157,6 +157,9 @@ fn ext_parser() -> impl clap::builder::TypedValueParser<Value = OutputKind> {
     Exit codes: 0 every input succeeded; 1 some input failed (the others were written); 2 usage error."
 )]
 pub struct MipArgs {
+    #[command(flatten)]
+    env: super::env_mip::EnvMipArgs,
+
     /// Input images (PNG, JPEG, TIFF, HDR, EXR, KTX2, DDS), directories of them, or builtin:NAME[:SIZE].
     #[arg(required = true, value_name = "INPUT")]
     inputs: Vec<String>,
@@ -580,6 +583,14 @@ fn roughness_settings(args: &MipArgs) -> Result<Option<RoughnessSettings>, Strin
 }
 
 pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
+    if super::env_mip::wanted(&args.env, &args.inputs) {
+        return super::env_mip::run(
+            &args.inputs,
+            args.output.as_deref(),
+            &args.env,
+            &settings(&args),
+        );
+    }
     let (jobs, settings) = match jobs_and_settings(&args) {
         Ok(js) => js,
         Err(code) => return Ok(code),

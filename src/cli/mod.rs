@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 mod cachesim;
 mod env;
+mod env_mip;
 mod images;
 mod info;
 mod mip;

@@ -516,6 +516,173 @@ pub fn faces_from_strip(strip: &Texture) -> Result<Vec<Texture>> {
         .collect()
 }
 
+/// The texel across an edge: `(i, j)` lies one texel outside face `f`
+/// of `n × n` texels in one of its coordinates (not both); the texel of
+/// the neighbour face its centre's direction lands on (the seamless
+/// rule of the GL specification, as [`CubeSampler`] reads it).
+pub fn across_edge(f: usize, n: u32, i: i64, j: i64) -> (usize, u32, u32) {
+    let nf = n as f64;
+    let d = face_direction(f, (i as f64 + 0.5) / nf, (j as f64 + 0.5) / nf);
+    let g = select_face(d);
+    let (s, t) = face_st(g, d);
+    let idx = |x: f64| ((x * nf).floor() as i64).clamp(0, n as i64 - 1) as u32;
+    (g, idx(s), idx(t))
+}
+
+/// Edge fix-up (as AMD CubeMapGen's "average" fix-up): in every level
+/// from `from_level` on whose faces are at least 2×2, each texel on a
+/// face edge becomes the mean of itself and the texel across the edge,
+/// and each corner texel the mean of the three texels that meet at the
+/// cube's corner. The texels on both sides of every edge are then equal,
+/// and equal to a box filter of the finer texels on both sides (for a
+/// box chain of power-of-two faces; colour weighted by alpha when alpha
+/// is straight, as the box filter weights it); a sampler without
+/// seamless cube filtering shows no seam. Levels of 1×1 faces are left alone (their
+/// one texel touches four faces). Values are computed in linear `f32`
+/// and stored back in each level's format.
+pub fn fix_edges(faces: Vec<MipChain>, from_level: usize) -> Result<Vec<MipChain>> {
+    if faces.len() != 6 {
+        return Err(Error::InvalidOption(format!(
+            "a cube map has six faces, got {}",
+            faces.len()
+        )));
+    }
+    let options: Vec<MipOptions> = faces.iter().map(|c| c.options().clone()).collect();
+    let mut levels: Vec<Vec<Texture>> = faces.into_iter().map(MipChain::into_levels).collect();
+    let count = levels.iter().map(Vec::len).min().unwrap_or(0);
+    for k in from_level..count {
+        let n = levels[0][k].width();
+        if n < 2 {
+            continue;
+        }
+        let lin: Vec<Vec<f32>> = (0..6).map(|f| levels[f][k].to_linear()).collect();
+        let ch = levels[0][k].channels();
+        let f0 = levels[0][k].format();
+        let straight = (f0.alpha == crate::texel::AlphaMode::Straight)
+            .then(|| f0.alpha_channel())
+            .flatten();
+        let mut out = lin.clone();
+        let at = |i: u32, j: u32| (j as usize * n as usize + i as usize) * ch;
+        let last = n as i64 - 1;
+        for (f, face_out) in out.iter_mut().enumerate() {
+            for j in 0..n {
+                for i in 0..n {
+                    let (ii, jj) = (i as i64, j as i64);
+                    let off_i = if ii == 0 {
+                        -1
+                    } else if ii == last {
+                        n as i64
+                    } else {
+                        ii
+                    };
+                    let off_j = if jj == 0 {
+                        -1
+                    } else if jj == last {
+                        n as i64
+                    } else {
+                        jj
+                    };
+                    let mut group = vec![(f, i, j)];
+                    if off_i != ii {
+                        group.push(across_edge(f, n, off_i, jj));
+                    }
+                    if off_j != jj {
+                        group.push(across_edge(f, n, ii, off_j));
+                    }
+                    if group.len() == 1 {
+                        continue;
+                    }
+                    let texels: Vec<&[f32]> = group
+                        .iter()
+                        .map(|&(g, a, b)| &lin[g][at(a, b)..at(a, b) + ch])
+                        .collect();
+                    let o = at(i, j);
+                    face_out[o..o + ch].copy_from_slice(&mean_texel(&texels, straight));
+                }
+            }
+        }
+        for (f, v) in out.into_iter().enumerate() {
+            let t = &levels[f][k];
+            levels[f][k] = Texture::from_linear(n, n, t.format(), &v)?;
+        }
+    }
+    levels
+        .into_iter()
+        .zip(options)
+        .map(|(l, o)| MipChain::from_levels(l, o))
+        .collect()
+}
+
+/// The mean of `texels` (linear values), colour weighted by alpha when
+/// alpha is straight (channel `straight`), as the box filter averages
+/// (plain means when every alpha is 0).
+fn mean_texel(texels: &[&[f32]], straight: Option<usize>) -> Vec<f32> {
+    let ch = texels[0].len();
+    let n = texels.len() as f32;
+    let plain: Vec<f32> = (0..ch)
+        .map(|c| texels.iter().map(|t| t[c]).sum::<f32>() / n)
+        .collect();
+    let Some(a) = straight else {
+        return plain;
+    };
+    let wsum: f32 = texels.iter().map(|t| t[a]).sum();
+    if wsum <= 0.0 {
+        return plain;
+    }
+    (0..ch)
+        .map(|c| {
+            if c == a {
+                plain[c]
+            } else {
+                texels.iter().map(|t| t[c] * t[a]).sum::<f32>() / wsum
+            }
+        })
+        .collect()
+}
+
+/// The vertical strip of six faces (`n × 6n`, +X, −X, +Y, −Y, +Z, −Z
+/// from the top): [`faces_from_strip`]'s inverse.
+pub fn strip_from_faces(faces: &[&Texture]) -> Result<Texture> {
+    let Some(first) = faces.first() else {
+        return Err(Error::InvalidOption(
+            "a cube map has six faces, got none".into(),
+        ));
+    };
+    let (n, fmt) = (first.width(), first.format());
+    if faces.len() != 6
+        || faces
+            .iter()
+            .any(|f| (f.width(), f.height(), f.format()) != (n, n, fmt))
+    {
+        return Err(Error::InvalidOption(format!(
+            "a cube map has six square faces of one size and format, got {} faces",
+            faces.len()
+        )));
+    }
+    fn join<T: Clone>(parts: impl Iterator<Item = Vec<T>>) -> Vec<T> {
+        parts.flatten().collect()
+    }
+    let texels = match first.texels() {
+        Texels::U8(_) => Texels::U8(join(faces.iter().map(|f| match f.texels() {
+            Texels::U8(v) => v.clone(),
+            _ => unreachable!("one format"),
+        }))),
+        Texels::U16(_) => Texels::U16(join(faces.iter().map(|f| match f.texels() {
+            Texels::U16(v) => v.clone(),
+            _ => unreachable!("one format"),
+        }))),
+        Texels::F16(_) => Texels::F16(join(faces.iter().map(|f| match f.texels() {
+            Texels::F16(v) => v.clone(),
+            _ => unreachable!("one format"),
+        }))),
+        Texels::F32(_) => Texels::F32(join(faces.iter().map(|f| match f.texels() {
+            Texels::F32(v) => v.clone(),
+            _ => unreachable!("one format"),
+        }))),
+    };
+    Texture::from_texels(n, 6 * n, fmt, texels)
+}
+
 /// A mip chain per face, each face filtered on its own with clamped
 /// edges (`options.wrap` is replaced by clamp-to-edge). With the box
 /// filter and power-of-two faces every coarser texel is the mean of the

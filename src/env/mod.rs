@@ -11,12 +11,15 @@
 //!   as OpenImageIO's `TextureSystem::environment()` does them.
 //! - [`prefilter`]: prefiltered specular levels (GGX, Beckmann, Phong
 //!   lobes, the split-sum convention) and diffuse irradiance (and SH9).
+//! - [`convert`]: a lat-long map as a cube map and back, by filtered
+//!   lookups over each new texel's footprint.
 //! - [`ArraySampler`]: a 2-D sampler per layer, the layer picked as GL
 //!   picks it.
 //!
 //! A direction lookup is a [`DirQuery`]: the direction (any length) and its
 //! change per pixel along screen x and y.
 
+pub mod convert;
 pub mod cube;
 mod cube_ewa;
 pub mod latlong;

@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 
 use super::{CONTAINERS, Limits, LoadOptions, Loaded, Overlap, SaveOptions};
 use crate::compress::BlockChain;
+use crate::env::Kind;
 use crate::error::{Error, Result};
 use crate::mip::Rounding;
 use crate::texel::{AlphaMode, ChannelType, Format};
@@ -179,6 +180,43 @@ pub trait Container: Send + Sync {
     fn stored_fingerprint(&self, _path: &Path) -> Option<String> {
         None
     }
+    /// True when the container can write an image of `kind` (every
+    /// output writes [`Kind::Plain`]).
+    fn holds(&self, kind: Kind) -> bool {
+        kind == Kind::Plain
+    }
+    /// Write the faces or layers of a cube map or an array (`images`,
+    /// each its levels, in [`super::Loaded::images`]'s order) or a
+    /// lat-long map to `path` atomically. Called by [`save_images`] after
+    /// the common checks, only for a `kind` the container
+    /// [`Container::holds`].
+    fn save_images(
+        &self,
+        _images: &[&[Texture]],
+        kind: Kind,
+        _rounding: Rounding,
+        path: &Path,
+        _options: &SaveOptions,
+    ) -> Result<()> {
+        Err(cannot_hold(self.name(), kind, path))
+    }
+}
+
+fn cannot_hold(name: &str, kind: Kind, path: &Path) -> Error {
+    let holders: Vec<String> = outputs()
+        .filter(|k| k.holds(kind))
+        .map(|k| format!(".{}", k.id()))
+        .collect();
+    Error::InvalidOption(format!(
+        "output `{}`: {name} cannot store a {}{}",
+        path.display(),
+        kind.describe(),
+        if holders.is_empty() {
+            String::new()
+        } else {
+            format!(" (use {})", or_list(&holders))
+        }
+    ))
 }
 
 fn not_writable(name: &str, path: &Path) -> Error {
@@ -375,6 +413,71 @@ pub fn save(
             first.channel_type()
         )));
     }
+    check_levels(levels, rounding)?;
+    kind.0.save(levels, rounding, path, options)
+}
+
+/// Write a texture of image kind `image_kind` to `path` atomically in the
+/// container `kind`: `images` holds each face or layer's levels (level
+/// 0 first, sizes following `rounding`, all of one size, format and
+/// level count; a cube's faces square), one entry for a 2-D or lat-long
+/// image.
+pub fn save_images(
+    images: &[&[Texture]],
+    image_kind: Kind,
+    rounding: Rounding,
+    path: &Path,
+    kind: OutputKind,
+    options: &SaveOptions,
+) -> Result<()> {
+    if !kind.holds(image_kind) {
+        return Err(cannot_hold(kind.name(), image_kind, path));
+    }
+    if images.len() != image_kind.images() {
+        return Err(Error::InvalidOption(format!(
+            "a {} holds {} images, got {}",
+            image_kind.describe(),
+            image_kind.images(),
+            images.len()
+        )));
+    }
+    let first = images[0];
+    check_levels(first, rounding)?;
+    if !kind.supports(first[0].channel_type()) {
+        return Err(Error::InvalidOption(format!(
+            "{kind:?} output cannot store {} texels",
+            first[0].channel_type()
+        )));
+    }
+    for (i, levels) in images.iter().enumerate() {
+        let same = levels.len() == first.len()
+            && levels.first().map(|l| (l.width(), l.height(), l.format()))
+                == first.first().map(|l| (l.width(), l.height(), l.format()));
+        if !same {
+            return Err(Error::InvalidOption(format!(
+                "image {i} of the {} differs from the first in size, format or level count",
+                image_kind.describe()
+            )));
+        }
+        check_levels(levels, rounding)?;
+    }
+    if image_kind.is_cube() && first[0].width() != first[0].height() {
+        return Err(Error::InvalidOption(format!(
+            "a cube map's faces must be square, got {}x{}",
+            first[0].width(),
+            first[0].height()
+        )));
+    }
+    kind.0
+        .save_images(images, image_kind, rounding, path, options)
+}
+
+/// Every level of `levels` the size `rounding` gives and the format of
+/// level 0.
+fn check_levels(levels: &[Texture], rounding: Rounding) -> Result<()> {
+    let Some(first) = levels.first() else {
+        return Err(Error::InvalidOption("nothing to write: no levels".into()));
+    };
     for (k, l) in levels.iter().enumerate() {
         let want = crate::mip::level_size(first.width(), first.height(), k as u32, rounding);
         if (l.width(), l.height()) != want || l.format() != first.format() {
@@ -389,7 +492,7 @@ pub fn save(
             )));
         }
     }
-    kind.0.save(levels, rounding, path, options)
+    Ok(())
 }
 
 #[cfg(test)]

@@ -69,6 +69,7 @@ use std::path::Path;
 
 use super::{FileFormat, Limits, Loaded, SourceInfo, atomic};
 use crate::compress::{BlockChain, BlockFormat};
+use crate::env::Kind;
 use crate::error::{Error, Result};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
@@ -135,6 +136,9 @@ pub mod caps {
     pub const MIPMAP: u32 = 0x400000;
     /// `dwCaps2`: a cube map.
     pub const CUBEMAP: u32 = 0x200;
+    /// `dwCaps2`: the six faces of a cube map (+X, −X, +Y, −Y, +Z, −Z:
+    /// 0x400 … 0x8000).
+    pub const ALL_FACES: u32 = 0xfc00;
     /// `dwCaps2`: a volume texture.
     pub const VOLUME: u32 = 0x200000;
 }
@@ -496,8 +500,93 @@ pub fn header_for(levels: &[Texture]) -> Result<(Header, Layout)> {
 /// Serialise `levels` (level 0 first, sizes rounding down) as DDS bytes.
 pub fn write_to(levels: &[Texture], out: &mut impl Write) -> Result<()> {
     let (header, lay) = header_for(levels)?;
+    out.write_all(&header.to_bytes()).map_err(encode_err)?;
+    write_levels(levels, &lay, out)
+}
+
+/// The DXGI format of a layout written with a legacy header, for the
+/// DX10 header an array needs (`None` for luminance + alpha, which DXGI
+/// has no format for).
+fn dx10_of_legacy(lay: &Layout) -> Option<(u32, u32)> {
+    use alpha_mode::*;
+    Some(match lay.name {
+        "L8" => (61, OPAQUE),
+        "X8B8G8R8" => (28, OPAQUE),
+        "A8B8G8R8" => (28, STRAIGHT),
+        "L16" => (56, OPAQUE),
+        "G16R16" => (35, OPAQUE),
+        "A16B16G16R16" => (11, STRAIGHT),
+        _ => return None,
+    })
+}
+
+/// The header of a cube map, an array or a cube-map array of `kind`
+/// whose images each hold `levels`' sizes and format: the legacy cube
+/// flags for one cube map, a DX10 header with `arraySize` for arrays.
+pub fn header_for_images(levels: &[Texture], kind: Kind) -> Result<(Header, Layout)> {
+    let (mut header, mut lay) = header_for(levels)?;
+    let count = match kind {
+        Kind::Plain | Kind::LatLong => return Ok((header, lay)),
+        Kind::Cube => 1,
+        Kind::CubeArray { cubes } => cubes,
+        Kind::Array { layers } => layers,
+    };
+    header.caps |= caps::COMPLEX;
+    if kind.is_cube() {
+        header.caps2 = caps::CUBEMAP | caps::ALL_FACES;
+    }
+    if count > 1 && header.dx10.is_none() {
+        let (dxgi, mode) = dx10_of_legacy(&lay).ok_or_else(|| {
+            encode_err(format!(
+                "a DDS array needs a DX10 format and DXGI has none for {} (write it to KTX2)",
+                lay.name
+            ))
+        })?;
+        header.pixel_format = fourcc_only(DX10);
+        header.dx10 = Some(Dx10 {
+            dxgi_format: dxgi,
+            resource_dimension: D3D10_RESOURCE_DIMENSION_TEXTURE2D,
+            misc_flag: 0,
+            array_size: 1,
+            misc_flags2: mode,
+        });
+        lay.dx10 = Some((dxgi, mode));
+    }
+    if let Some(d) = &mut header.dx10 {
+        d.array_size = count;
+        if kind.is_cube() {
+            d.misc_flag |= D3D11_RESOURCE_MISC_TEXTURECUBE;
+        }
+    }
+    Ok((header, lay))
+}
+
+/// Serialise a cube map or an array (`images` in
+/// [`super::Loaded::images`]'s order, each its levels) as DDS bytes:
+/// image after image, each with all its levels.
+pub fn write_images_to(images: &[&[Texture]], kind: Kind, out: &mut impl Write) -> Result<()> {
+    let first = images
+        .first()
+        .ok_or_else(|| encode_err("nothing to write: no images"))?;
+    let (header, lay) = header_for_images(first, kind)?;
+    out.write_all(&header.to_bytes()).map_err(encode_err)?;
+    for levels in images {
+        write_levels(levels, &lay, out)?;
+    }
+    Ok(())
+}
+
+/// Write a cube map or an array atomically (see [`write_images_to`]).
+pub fn save_images(images: &[&[Texture]], kind: Kind, path: &Path) -> Result<()> {
+    if let Some(first) = images.first() {
+        header_for_images(first, kind)?;
+    }
+    atomic::write(path, |w| write_images_to(images, kind, w))
+}
+
+/// One image's levels in `lay`'s stored channels.
+fn write_levels(levels: &[Texture], lay: &Layout, out: &mut impl Write) -> Result<()> {
     let io = |e: std::io::Error| encode_err(e);
-    out.write_all(&header.to_bytes()).map_err(io)?;
     for l in levels {
         if lay.stored_channels as usize == l.channels() {
             out.write_all(&super::le_bytes(l.texels())).map_err(io)?;
@@ -1278,31 +1367,61 @@ pub fn read_header(path: &Path) -> Result<Header> {
     Header::parse(&head)
 }
 
-/// The kinds of DDS file parvo does not read (cube maps, volumes, arrays,
-/// buffers), refused in words before any texel is read.
+/// The kind of image a file starting with `head` (its header) holds;
+/// a plain 2-D image when it cannot tell.
+pub(crate) fn peek_kind(head: &[u8]) -> Kind {
+    Header::parse(head)
+        .ok()
+        .and_then(|h| dds_kind(&h).ok())
+        .unwrap_or(Kind::Plain)
+}
+
+/// The kind of image a header describes: a cube map (the legacy cube
+/// flag with all six faces, or DX10's `TEXTURECUBE` with `arraySize`
+/// cubes), an array (DX10 `arraySize` > 1) or one 2-D image.
+fn dds_kind(header: &Header) -> Result<Kind> {
+    let dx_cube = header
+        .dx10
+        .is_some_and(|d| d.misc_flag & D3D11_RESOURCE_MISC_TEXTURECUBE != 0);
+    // An array size of 0 is read as 1, as Pillow and OpenImageIO read it
+    // (they ignore the field; Pillow's own `bc1.dds` has 0).
+    let count = header.dx10.map_or(1, |d| d.array_size.max(1));
+    if dx_cube || header.caps2 & caps::CUBEMAP != 0 {
+        if !dx_cube && header.caps2 & caps::ALL_FACES != caps::ALL_FACES {
+            return Err(decode_err(format!(
+                "a cube map with only {} of its six faces (parvo reads whole cube maps)",
+                (header.caps2 & caps::ALL_FACES).count_ones()
+            )));
+        }
+        if header.width != header.height {
+            return Err(decode_err(format!(
+                "a cube map's faces must be square, the header gives {}x{}",
+                header.width, header.height
+            )));
+        }
+        return Ok(if count == 1 {
+            Kind::Cube
+        } else {
+            Kind::CubeArray { cubes: count }
+        });
+    }
+    Ok(if count == 1 {
+        Kind::Plain
+    } else {
+        Kind::Array { layers: count }
+    })
+}
+
+/// The kinds of DDS file parvo does not read (volumes, buffers), refused
+/// in words before any texel is read.
 fn refuse_unsupported(header: &Header) -> Result<()> {
     let h = header.height;
-    if header.caps2 & caps::CUBEMAP != 0
-        || header
-            .dx10
-            .is_some_and(|d| d.misc_flag & D3D11_RESOURCE_MISC_TEXTURECUBE != 0)
-    {
-        return Err(decode_err(
-            "cube maps are not supported (parvo reads 2-D textures)",
-        ));
-    }
     if header.caps2 & caps::VOLUME != 0 || (header.flags & ddsd::DEPTH != 0 && header.depth > 1) {
         return Err(decode_err(
             "volume textures are not supported (parvo reads 2-D textures)",
         ));
     }
     if let Some(d) = &header.dx10 {
-        if d.array_size > 1 {
-            return Err(decode_err(format!(
-                "texture arrays are not supported (this one has {} layers)",
-                d.array_size
-            )));
-        }
         match d.resource_dimension {
             D3D10_RESOURCE_DIMENSION_TEXTURE2D => {}
             // Unknown: Pillow and OpenImageIO do not read the field and take
@@ -1337,14 +1456,25 @@ fn refuse_unsupported(header: &Header) -> Result<()> {
 }
 
 /// Load a DDS file: every mip level of a 2-D texture (see the module docs
-/// for the formats read).
+/// for the formats read); a cube map or an array is refused (see
+/// [`load_with`]).
 pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
+    load_with(path, limits, &super::LoadOptions::default())
+}
+
+/// [`load`] with [`super::LoadOptions`]: cube maps and arrays are read
+/// whole (every face and layer, each with its levels) when `options`
+/// accept them.
+pub fn load_with(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Result<Loaded> {
     let header = read_header(path)?;
     let (w, h) = (header.width, header.height);
     if w == 0 || h == 0 {
         return Err(decode_err(format!("the header declares a {w}x{h} texture")));
     }
     refuse_unsupported(&header)?;
+    let kind = dds_kind(&header)?;
+    super::layered_image("DDS", kind, (w, h), options)?;
+    let images = kind.images();
     let (stored, desc) = stored_of(&header)?;
     let full = crate::mip::level_count(w, h, crate::mip::Rounding::Down, None);
     let declared = header.mip_map_count.max(1);
@@ -1364,7 +1494,8 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         sizes
             .iter()
             .map(|&(a, b)| a as u64 * b as u64 * f.texel_bytes() as u64)
-            .sum()
+            .sum::<u64>()
+            .saturating_mul(images as u64)
     };
     let file_len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     limits.check(w as u64, h as u64, decoded_bytes.saturating_add(file_len))?;
@@ -1373,24 +1504,24 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         action: "cannot read".into(),
         error: e,
     })?;
+    // Image by image (face or layer), each with all its levels.
     let mut at = header.data_offset();
-    let mut levels = Vec::with_capacity(sizes.len());
-    for (k, &(lw, lh)) in sizes.iter().enumerate() {
-        let need = stored_len(&stored, lw, lh) as usize;
-        let Some(data) = bytes.get(at..at + need) else {
-            if k > 0 && header.flags & ddsd::MIPMAPCOUNT == 0 {
-                // A mip count without its flag, and no data for it: the
-                // file holds one level (DirectXTex would refuse it).
-                break;
-            }
-            return Err(decode_err(format!(
-                "the file ends inside level {k} ({lw}x{lh}, {need} bytes from offset {at}; the file has {})",
-                bytes.len()
-            )));
-        };
-        levels.push(decode_level(&stored, lw, lh, data)?);
-        at += need;
+    let mut all: Vec<Vec<Texture>> = Vec::with_capacity(images);
+    for image in 0..images {
+        all.push(
+            read_levels(&bytes, &mut at, &stored, &sizes, &header, images > 1).map_err(
+                |e| match e {
+                    Error::Decode { format, reason } if images > 1 => Error::Decode {
+                        format,
+                        reason: format!("image {image} of {images}: {reason}"),
+                    },
+                    e => e,
+                },
+            )?,
+        );
     }
+    let mut all = all.into_iter();
+    let levels = all.next().expect("one image or more");
     let base = &levels[0];
     let format = base.format();
     let mut info = SourceInfo::new(FileFormat::Dds, &format);
@@ -1427,7 +1558,41 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
         info.attributes.push(("dds:alphaMode".into(), mode.into()));
     }
     info.attributes.sort();
-    Ok(Loaded { levels, info })
+    info.kind = kind;
+    Ok(Loaded {
+        levels,
+        info,
+        images: all.collect(),
+    })
+}
+
+/// The levels of one image from `bytes` at `*at` (moved past them).
+fn read_levels(
+    bytes: &[u8],
+    at: &mut usize,
+    stored: &Stored,
+    sizes: &[(u32, u32)],
+    header: &Header,
+    layered: bool,
+) -> Result<Vec<Texture>> {
+    let mut levels = Vec::with_capacity(sizes.len());
+    for (k, &(lw, lh)) in sizes.iter().enumerate() {
+        let need = stored_len(stored, lw, lh) as usize;
+        let Some(data) = bytes.get(*at..*at + need) else {
+            if k > 0 && !layered && header.flags & ddsd::MIPMAPCOUNT == 0 {
+                // A mip count without its flag, and no data for it: the
+                // file holds one level (DirectXTex would refuse it).
+                break;
+            }
+            return Err(decode_err(format!(
+                "the file ends inside level {k} ({lw}x{lh}, {need} bytes from offset {at}; the file has {})",
+                bytes.len()
+            )));
+        };
+        levels.push(decode_level(stored, lw, lh, data)?);
+        *at += need;
+    }
+    Ok(levels)
 }
 
 /// DDS in the container table: reads legacy and DX10 headers
@@ -1455,10 +1620,10 @@ impl super::Container for Dds {
         &self,
         path: &Path,
         limits: &Limits,
-        _options: &super::LoadOptions,
+        options: &super::LoadOptions,
         _overlap: Option<super::Overlap<'_>>,
     ) -> Result<Loaded> {
-        load(path, limits)
+        load_with(path, limits, options)
     }
     fn read_extensions(&self) -> &'static [&'static str] {
         &["dds"]
@@ -1490,6 +1655,19 @@ impl super::Container for Dds {
         _options: &super::SaveOptions,
     ) -> Result<()> {
         save_blocks(chain, path)
+    }
+    fn holds(&self, kind: Kind) -> bool {
+        kind != Kind::LatLong
+    }
+    fn save_images(
+        &self,
+        images: &[&[Texture]],
+        kind: Kind,
+        _rounding: crate::mip::Rounding,
+        path: &Path,
+        _options: &super::SaveOptions,
+    ) -> Result<()> {
+        save_images(images, kind, path)
     }
 }
 

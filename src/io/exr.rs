@@ -186,6 +186,31 @@ fn exr_level_sizes(w: u32, h: u32, r: Rounding) -> Vec<(u32, u32)> {
 /// mip` (6.7 s of 8.1 s for a 4096² RGBA half texture on two cores); every
 /// other compression goes through the `exr` crate.
 pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOptions) -> Result<()> {
+    save_as(levels, rounding, path, opts, None)
+}
+
+/// [`save`] of an environment map: a lat-long image, or a cube map's six
+/// faces stacked top to bottom (+X, −X, +Y, −Y, +Z, −Z) in every level,
+/// marked with OpenEXR's `envmap` attribute and maketx's `textureformat`
+/// (`LatLong Environment`, `CubeFace Environment`), as `maketx --envlatl`
+/// and `--envcube` write them.
+pub fn save_environment(
+    levels: &[Texture],
+    rounding: Rounding,
+    path: &Path,
+    opts: &SaveOptions,
+    env: super::Environment,
+) -> Result<()> {
+    save_as(levels, rounding, path, opts, Some(env))
+}
+
+fn save_as(
+    levels: &[Texture],
+    rounding: Rounding,
+    path: &Path,
+    opts: &SaveOptions,
+    env: Option<super::Environment>,
+) -> Result<()> {
     let first = &levels[0];
     let (w, h) = (first.width(), first.height());
     let want = exr_level_sizes(w, h, rounding);
@@ -198,7 +223,10 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
             crate::setting::Setting::Levels,
         )));
     }
-    let (header, tiles) = plan(w, h, first.format(), levels.len() > 1, rounding, opts)?;
+    let (mut header, tiles) = plan(w, h, first.format(), levels.len() > 1, rounding, opts)?;
+    if let Some(env) = env {
+        mark_environment(&mut header, env);
+    }
     write_file(path, header, |meta, writer| {
         let blocks: Vec<(usize, BlockIndex)> =
             meta.enumerate_ordered_header_block_indices().collect();
@@ -206,6 +234,21 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
             tiles.chunk(&levels[index.level.x()], 0, index, &meta.headers)
         })
     })
+}
+
+/// `envmap` and `textureformat` of an environment map of kind `env`.
+fn mark_environment(header: &mut Header, env: super::Environment) {
+    use ::exr::meta::attribute::EnvironmentMap;
+    let (map, name) = match env {
+        super::Environment::LatLong => (EnvironmentMap::LatitudeLongitude, "LatLong Environment"),
+        super::Environment::Cube => (EnvironmentMap::Cube, "CubeFace Environment"),
+    };
+    let attrs = &mut header.own_attributes;
+    attrs.environment_map = Some(map);
+    attrs.other.insert(
+        Text::from("textureformat"),
+        AttributeValue::Text(Text::from(name)),
+    );
 }
 
 /// Where level 0 of a streamed EXR write ([`save_streamed`]) comes from:
@@ -702,6 +745,34 @@ pub fn stored_fingerprint(path: &Path) -> Option<String> {
     }
 }
 
+/// The kind of environment an OpenEXR file's first header declares
+/// (`envmap`, or maketx's `textureformat`), from its headers alone:
+/// [`crate::env::Kind::Cube`] for a cube-face strip, `LatLong`, else
+/// `Plain` (also for a file whose headers do not read).
+pub(crate) fn peek_kind(path: &Path) -> crate::env::Kind {
+    use crate::env::Kind;
+    use ::exr::meta::attribute::EnvironmentMap;
+    let read = || {
+        let meta = MetaData::read_from_file(path, false).ok()?;
+        let h = meta.headers.first()?;
+        let format = match h.own_attributes.other.get(&Text::from("textureformat")) {
+            Some(AttributeValue::Text(t)) => t.to_string(),
+            _ => String::new(),
+        };
+        Some(match (h.own_attributes.environment_map, format.as_str()) {
+            (Some(EnvironmentMap::Cube), _) | (None, "CubeFace Environment") => Kind::Cube,
+            (Some(EnvironmentMap::LatitudeLongitude), _) | (None, "LatLong Environment") => {
+                Kind::LatLong
+            }
+            _ => Kind::Plain,
+        })
+    };
+    std::panic::catch_unwind(read)
+        .ok()
+        .flatten()
+        .unwrap_or(Kind::Plain)
+}
+
 fn attribute_text(v: &AttributeValue) -> String {
     match v {
         AttributeValue::Text(t) => t.to_string(),
@@ -974,8 +1045,11 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         // OpenEXR stores linear values by definition.
         color_stated: true,
         environment,
+        // A cube-face environment stays one strip image here
+        // (`environment` says what it is).
+        kind: crate::env::Kind::Plain,
     };
-    Ok(Loaded { levels, info })
+    Ok(Loaded::plain(levels, info))
 }
 
 /// The levels a header declares.
@@ -1409,4 +1483,67 @@ impl super::Container for OpenExr {
     fn stored_fingerprint(&self, path: &Path) -> Option<String> {
         stored_fingerprint(path)
     }
+    fn holds(&self, kind: crate::env::Kind) -> bool {
+        use crate::env::Kind;
+        matches!(kind, Kind::Plain | Kind::LatLong | Kind::Cube)
+    }
+    fn save_images(
+        &self,
+        images: &[&[Texture]],
+        kind: crate::env::Kind,
+        rounding: Rounding,
+        path: &Path,
+        options: &SaveOptions,
+    ) -> Result<()> {
+        use crate::env::Kind;
+        match kind {
+            Kind::Plain => save(images[0], rounding, path, options),
+            Kind::LatLong => save_environment(
+                images[0],
+                rounding,
+                path,
+                options,
+                super::Environment::LatLong,
+            ),
+            _ => {
+                let strip = cube_strip_levels(images, rounding)?;
+                save_environment(&strip, rounding, path, options, super::Environment::Cube)
+            }
+        }
+    }
+}
+
+/// The levels of OpenEXR's cube-map strip for six faces' levels: level k
+/// stacks the faces' level k while they are at least 1×1; the strip's
+/// last levels (1×3, 1×1), which OpenEXR's level rule asks for but no
+/// face has, are box-filtered from the 1×6 strip. Faces of a size that
+/// is not a power of two cannot keep apart in the strip's levels.
+fn cube_strip_levels(faces: &[&[Texture]], rounding: Rounding) -> Result<Vec<Texture>> {
+    let n = faces[0][0].width();
+    let mut strip: Vec<Texture> = (0..faces[0].len())
+        .map(|k| {
+            let level: Vec<&Texture> = faces.iter().map(|f| &f[k]).collect();
+            crate::env::cube::strip_from_faces(&level)
+        })
+        .collect::<Result<_>>()?;
+    if strip.len() == 1 {
+        return Ok(strip);
+    }
+    let face_levels = crate::mip::level_count(n, n, rounding, None) as usize;
+    if !n.is_power_of_two() || strip.len() != face_levels {
+        return Err(encode_err(format!(
+            "an OpenEXR cube map stacks its six faces in each level, which keeps them apart only \
+             for power-of-two faces with every level down to 1x1 (got {n}x{n} faces with {} \
+             levels); KTX2 and DDS store any cube map",
+            strip.len()
+        )));
+    }
+    let last = strip.pop().expect("two levels or more");
+    let options = crate::mip::MipOptions {
+        rounding,
+        ..Default::default()
+    };
+    let tail = crate::mip::build(last, &options)?;
+    strip.extend(tail.into_levels());
+    Ok(strip)
 }

@@ -322,10 +322,7 @@ fn load_image(
     info.attributes = attributes;
     info.notes = notes;
     info.color_stated = color_stated;
-    Ok(Loaded {
-        levels: vec![tex],
-        info,
-    })
+    Ok(Loaded::plain(vec![tex], info))
 }
 
 /// Decode the whole image, running `overlap` on another thread meanwhile.

@@ -46,6 +46,7 @@ use std::path::Path;
 
 use super::{FINGERPRINT_KEY, FileFormat, Limits, Loaded, SaveOptions, SourceInfo, atomic};
 use crate::compress::{BlockChain, BlockFormat};
+use crate::env::Kind;
 use crate::error::{Error, Result};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format};
 use crate::texture::Texture;
@@ -508,9 +509,64 @@ fn block_has_alpha(f: BlockFormat, bc1_alpha: bool) -> bool {
 /// Serialise `levels` (level 0 first, sizes rounding down) as KTX2 bytes
 /// written to `out`.
 pub fn write_to(levels: &[Texture], opts: &SaveOptions, out: &mut impl Write) -> Result<()> {
+    write_images_to(&[levels], Kind::Plain, opts, out)
+}
+
+/// The header's layer and face counts for `kind` holding `images` 2-D
+/// images (KTX 2.0 section 3.4), or why it cannot.
+fn layer_face_counts(kind: Kind, images: usize) -> Result<(u32, u32)> {
+    if kind.images() != images {
+        return Err(encode_err(format!(
+            "a {} holds {} images, got {images}",
+            kind.describe(),
+            kind.images()
+        )));
+    }
+    Ok(match kind {
+        Kind::Plain | Kind::LatLong => (0, 1),
+        Kind::Array { layers } => (layers, 1),
+        Kind::Cube => (0, 6),
+        Kind::CubeArray { cubes } => (cubes, 6),
+    })
+}
+
+/// Serialise a cube map, an array or a 2-D texture of `kind`: `images`
+/// holds each face or layer's levels (level 0 first, sizes rounding
+/// down, every image the same size, format and level count), in the
+/// order of [`super::Loaded::images`]; each KTX2 level holds level k of
+/// every image, one after the other.
+pub fn write_images_to(
+    images: &[&[Texture]],
+    kind: Kind,
+    opts: &SaveOptions,
+    out: &mut impl Write,
+) -> Result<()> {
+    let (layers, faces) = layer_face_counts(kind, images.len())?;
+    let levels = *images
+        .first()
+        .ok_or_else(|| encode_err("nothing to write: no images"))?;
     let first = levels
         .first()
         .ok_or_else(|| encode_err("nothing to write: no levels"))?;
+    for (i, image) in images.iter().enumerate() {
+        let same = image.len() == levels.len()
+            && image.iter().zip(levels).all(|(a, b)| {
+                (a.width(), a.height(), a.format()) == (b.width(), b.height(), b.format())
+            });
+        if !same {
+            return Err(encode_err(format!(
+                "image {i} of the {} differs from the first in size, format or level count",
+                kind.describe()
+            )));
+        }
+    }
+    if faces == 6 && first.width() != first.height() {
+        return Err(encode_err(format!(
+            "a cube map's faces must be square, got {}x{}",
+            first.width(),
+            first.height()
+        )));
+    }
     let f = first.format();
     let vk = vk_format(&f).ok_or_else(|| {
         encode_err(format!(
@@ -523,8 +579,36 @@ pub fn write_to(levels: &[Texture], opts: &SaveOptions, out: &mut impl Write) ->
         dfd: dfd(&f),
         block_bytes: f.texel_bytes() as u64,
     };
-    let payloads: Vec<_> = levels.iter().map(|l| super::le_bytes(l.texels())).collect();
-    write_payloads((first.width(), first.height()), &desc, &payloads, opts, out)
+    let payloads: Vec<std::borrow::Cow<[u8]>> = if images.len() == 1 {
+        levels.iter().map(|l| super::le_bytes(l.texels())).collect()
+    } else {
+        (0..levels.len())
+            .map(|k| {
+                let mut level = Vec::new();
+                for image in images {
+                    level.extend_from_slice(&super::le_bytes(image[k].texels()));
+                }
+                std::borrow::Cow::Owned(level)
+            })
+            .collect()
+    };
+    let shape = Shape {
+        width: first.width(),
+        height: first.height(),
+        layers,
+        faces,
+    };
+    write_payloads(shape, &desc, &payloads, opts, out)
+}
+
+/// The header's image dimensions.
+struct Shape {
+    width: u32,
+    height: u32,
+    /// `layerCount` (0: not an array).
+    layers: u32,
+    /// `faceCount` (6 for a cube map).
+    faces: u32,
 }
 
 /// Serialise a block-compressed chain as KTX2 bytes written to `out`.
@@ -548,14 +632,20 @@ pub fn write_blocks_to(chain: &BlockChain, opts: &SaveOptions, out: &mut impl Wr
         .iter()
         .map(|l| std::borrow::Cow::Borrowed(l.as_slice()))
         .collect();
-    write_payloads((chain.width, chain.height), &desc, &payloads, opts, out)
+    let shape = Shape {
+        width: chain.width,
+        height: chain.height,
+        layers: 0,
+        faces: 1,
+    };
+    write_payloads(shape, &desc, &payloads, opts, out)
 }
 
 /// The container around the levels' bytes: header, level index, DFD,
 /// key/value data, then the levels smallest first, supercompressed (on
 /// all threads) when `opts` asks.
 fn write_payloads(
-    (width, height): (u32, u32),
+    shape: Shape,
     desc: &Desc,
     payloads: &[std::borrow::Cow<[u8]>],
     opts: &SaveOptions,
@@ -622,11 +712,11 @@ fn write_payloads(
     for v in [
         desc.vk,
         desc.type_size,
-        width,
-        height,
+        shape.width,
+        shape.height,
         0,
-        0,
-        1,
+        shape.layers,
+        shape.faces,
         n as u32,
         opts.supercompression.map_or(0, |s| s.scheme()),
     ] {
@@ -667,6 +757,17 @@ pub fn save_blocks(chain: &BlockChain, path: &Path, opts: &SaveOptions) -> Resul
 /// Write `levels` to a `.ktx2` file atomically.
 pub fn save(levels: &[Texture], path: &Path, opts: &SaveOptions) -> Result<()> {
     atomic::write(path, |w| write_to(levels, opts, w))
+}
+
+/// Write a cube map, an array or a 2-D texture (see [`write_images_to`])
+/// to a `.ktx2` file atomically.
+pub fn save_images(
+    images: &[&[Texture]],
+    kind: Kind,
+    path: &Path,
+    opts: &SaveOptions,
+) -> Result<()> {
+    atomic::write(path, |w| write_images_to(images, kind, opts, w))
 }
 
 fn read_bytes(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
@@ -830,14 +931,27 @@ fn orientation(value: &str, two_d: bool) -> (u16, Option<String>) {
 /// put in parvo's order (top to bottom, left to right) as its
 /// `KTXorientation` says.
 pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
-    let bytes = read_bytes(path, limits)?;
-    load_bytes(&bytes, limits)
+    load_with(path, limits, &super::LoadOptions::default())
 }
 
-fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
+/// [`load`] with [`super::LoadOptions`]: cube maps and arrays are read
+/// whole (every face and layer) when `options` accept them.
+pub fn load_with(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Result<Loaded> {
+    let bytes = read_bytes(path, limits)?;
+    load_bytes(&bytes, limits, options)
+}
+
+fn load_bytes(bytes: &[u8], limits: &Limits, options: &super::LoadOptions) -> Result<Loaded> {
     let r = reader(bytes)?;
     let h = r.header();
-    refuse_image_kind(&h)?;
+    let kind = image_kind(&h)?;
+    let mut notes = Vec::new();
+    super::layered_image(
+        "KTX2",
+        kind,
+        (h.pixel_width, h.pixel_height.max(1)),
+        options,
+    )?;
     let scheme = u32::from_le_bytes(bytes[44..48].try_into().map_err(decode_err)?);
     let vk = h.format.map(|f| f.value()).unwrap_or(0);
     let block = block_format_of_vk(vk);
@@ -848,7 +962,6 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
         })?,
     };
     let premultiplied = dfd_premultiplied(bytes);
-    let mut notes = Vec::new();
     format = apply_swizzle(&r, format, block.is_some(), &mut notes);
     if premultiplied && format.has_alpha() {
         format = format.with_alpha(AlphaMode::Premultiplied);
@@ -860,13 +973,17 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
         block,
         format,
         premultiplied,
+        images: kind.images(),
     };
     stored.check_decoded_size(r.levels().len(), bytes.len(), limits)?;
-    let mut levels = Vec::new();
+    // images[i][k]: level k of face or layer i.
+    let mut images: Vec<Vec<Texture>> = vec![Vec::new(); stored.images];
     for (k, level) in r.levels().enumerate() {
-        levels.push(stored.read(k, &level, limits)?);
+        for (i, t) in stored.read(k, &level, limits)?.into_iter().enumerate() {
+            images[i].push(t);
+        }
     }
-    if levels.is_empty() {
+    if images[0].is_empty() {
         return Err(decode_err("no levels"));
     }
     if let Some((_, v)) = r.key_value_data().find(|(k, _)| *k == "KTXorientation") {
@@ -874,14 +991,20 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
             .trim_end_matches('\0')
             .to_string();
         let (code, note) = orientation(&text, h.pixel_height > 0);
-        if code != 1 {
-            levels = levels
-                .iter()
-                .map(|l| super::orient(l, code))
-                .collect::<Result<_>>()?;
+        // A cube map's faces are defined in their own orientation
+        // (KTX 2.0 section 4.2): KTXorientation does not apply to them.
+        if code != 1 && !kind.is_cube() {
+            for levels in &mut images {
+                *levels = levels
+                    .iter()
+                    .map(|l| super::orient(l, code))
+                    .collect::<Result<_>>()?;
+            }
         }
         notes.extend(note);
     }
+    let mut images = images.into_iter();
+    let levels = images.next().expect("at least one image");
     let attributes = attributes_of(&r, vk, block, scheme);
     let wrap = super::recorded_wrap(
         attributes
@@ -902,7 +1025,12 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
     info.blocks = block.map(|b| b.0);
     info.wrap = wrap;
     info.attributes = attributes;
-    Ok(Loaded { levels, info })
+    info.kind = kind;
+    Ok(Loaded {
+        levels,
+        info,
+        images: images.collect(),
+    })
 }
 
 /// How a file's levels are stored, from its header: what sizing,
@@ -920,6 +1048,9 @@ struct StoredLevels {
     format: Format,
     /// The DFD says alpha is premultiplied.
     premultiplied: bool,
+    /// Faces times layers: the 2-D images each level holds, one after
+    /// the other (KTX 2.0 section 3.9.7).
+    images: usize,
 }
 
 impl StoredLevels {
@@ -933,12 +1064,18 @@ impl StoredLevels {
         )
     }
 
-    /// Bytes of a `w × h` level as stored (before supercompression).
-    fn stored_len(&self, (w, h): (u32, u32)) -> u64 {
+    /// Bytes of one `w × h` image as stored (before supercompression).
+    fn image_len(&self, (w, h): (u32, u32)) -> u64 {
         match self.block {
             Some((bf, ..)) => bf.level_bytes(w, h),
             None => w as u64 * h as u64 * self.format.texel_bytes() as u64,
         }
+    }
+
+    /// Bytes of a `w × h` level as stored (every face and layer, before
+    /// supercompression).
+    fn stored_len(&self, size: (u32, u32)) -> u64 {
+        self.image_len(size).saturating_mul(self.images as u64)
     }
 
     /// Hold what decoding `count` levels of a file of `file_len` bytes
@@ -951,7 +1088,9 @@ impl StoredLevels {
         let decoded: u64 = (0..count)
             .map(|k| {
                 let (lw, lh) = self.size(k);
-                (lw as u64 * lh as u64).saturating_mul(self.format.texel_bytes() as u64)
+                (lw as u64 * lh as u64)
+                    .saturating_mul(self.format.texel_bytes() as u64)
+                    .saturating_mul(self.images as u64)
             })
             .fold(0, u64::saturating_add);
         let inflated = if self.scheme != 0 {
@@ -968,9 +1107,9 @@ impl StoredLevels {
         )
     }
 
-    /// Level `k`: inflated when supercompressed, its length checked,
-    /// decoded.
-    fn read(&self, k: usize, level: &::ktx2::Level<'_>, limits: &Limits) -> Result<Texture> {
+    /// Level `k` of every face and layer: inflated when supercompressed,
+    /// its length checked, decoded.
+    fn read(&self, k: usize, level: &::ktx2::Level<'_>, limits: &Limits) -> Result<Vec<Texture>> {
         let (lw, lh) = self.size(k);
         let need = self.stored_len((lw, lh));
         let unpacked;
@@ -997,7 +1136,9 @@ impl StoredLevels {
                 None => format!("level {k} has {} bytes, {lw}x{lh} needs {need}", data.len()),
             }));
         }
-        self.decode(data, (lw, lh))
+        data.chunks_exact(self.image_len((lw, lh)) as usize)
+            .map(|image| self.decode(image, (lw, lh)))
+            .collect()
     }
 
     /// One `w × h` level from its stored bytes (inflated, of the right
@@ -1023,14 +1164,28 @@ impl StoredLevels {
     }
 }
 
-/// Refuse what is not one 2-D texture: cube maps, volumes, arrays.
-fn refuse_image_kind(h: &::ktx2::Header) -> Result<()> {
-    if h.face_count == 6 {
-        return Err(decode_err(
-            "cube maps are not supported (parvo reads 2-D textures)",
-        ));
+/// The kind of image a file starting with `head` holds, from its
+/// header's layer and face counts alone (a plain 2-D image when the
+/// header is too short or not a cube map or an array).
+pub(crate) fn peek_kind(head: &[u8]) -> Kind {
+    let word = |at: usize| {
+        head.get(at..at + 4)
+            .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    match (word(36), word(32)) {
+        (6, 0) => Kind::Cube,
+        (6, cubes) => Kind::CubeArray { cubes },
+        (1, 0) => Kind::Plain,
+        (1, layers) => Kind::Array { layers },
+        _ => Kind::Plain,
     }
-    if h.face_count != 1 {
+}
+
+/// The kind of image the header describes (KTX 2.0 section 3.4: a
+/// layer count of 0 is not an array, 1 or more is); volumes and face
+/// counts other than 1 and 6 are refused.
+fn image_kind(h: &::ktx2::Header) -> Result<Kind> {
+    if h.face_count != 1 && h.face_count != 6 {
         return Err(decode_err(format!(
             "the header gives {} faces (1, or 6 for a cube map)",
             h.face_count
@@ -1039,17 +1194,23 @@ fn refuse_image_kind(h: &::ktx2::Header) -> Result<()> {
     if h.pixel_depth > 1 {
         return Err(decode_err(format!(
             "volume textures are not supported (this one is {} texels deep; parvo reads 2-D \
-             textures)",
+             textures, arrays and cube maps)",
             h.pixel_depth
         )));
     }
-    if h.layer_count > 1 {
+    let cube = h.face_count == 6;
+    if cube && (h.pixel_width != h.pixel_height) {
         return Err(decode_err(format!(
-            "texture arrays are not supported (this one has {} layers)",
-            h.layer_count
+            "a cube map's faces must be square, the header gives {}x{}",
+            h.pixel_width, h.pixel_height
         )));
     }
-    Ok(())
+    Ok(match (cube, h.layer_count) {
+        (false, 0) => Kind::Plain,
+        (false, layers) => Kind::Array { layers },
+        (true, 0) => Kind::Cube,
+        (true, cubes) => Kind::CubeArray { cubes },
+    })
 }
 
 /// `format` as the file's `KTXswizzle` (KTX 2.0 section "KTXswizzle")
@@ -1154,10 +1315,10 @@ impl super::Container for Ktx2 {
         &self,
         path: &Path,
         limits: &Limits,
-        _options: &super::LoadOptions,
+        options: &super::LoadOptions,
         _overlap: Option<super::Overlap<'_>>,
     ) -> Result<Loaded> {
-        load(path, limits)
+        load_with(path, limits, options)
     }
     fn read_extensions(&self) -> &'static [&'static str] {
         &["ktx2"]
@@ -1189,5 +1350,18 @@ impl super::Container for Ktx2 {
     }
     fn stored_fingerprint(&self, path: &Path) -> Option<String> {
         stored_fingerprint(path)
+    }
+    fn holds(&self, kind: Kind) -> bool {
+        kind != Kind::LatLong
+    }
+    fn save_images(
+        &self,
+        images: &[&[Texture]],
+        kind: Kind,
+        _rounding: crate::mip::Rounding,
+        path: &Path,
+        options: &SaveOptions,
+    ) -> Result<()> {
+        save_images(images, kind, path, options)
     }
 }

@@ -41,7 +41,7 @@ use crate::texel::{ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::Wrap;
 
-pub use container::{Container, OutputKind, Stores, save};
+pub use container::{Container, OutputKind, Stores, save, save_images};
 
 /// The container table ([`container`]): every container, in detection
 /// order; the last reads whatever no other claims. A new container is a
@@ -134,6 +134,13 @@ pub struct SourceInfo {
     /// [`LoadOptions::environment`] asks to describe them; see
     /// [`EnvironmentMaps`]).
     pub environment: Option<Environment>,
+    /// What kind of image the file holds: one 2-D image, an array, a
+    /// cube map or an array of them (KTX2, DDS); [`Loaded::images`] holds
+    /// the faces or layers after the first. Loaders set it only when
+    /// [`LoadOptions::environment`] lets them read such files (see
+    /// [`EnvironmentMaps`]); a lat-long OpenEXR stays `Plain` here and is
+    /// told by [`SourceInfo::environment`].
+    pub kind: crate::env::Kind,
 }
 
 impl SourceInfo {
@@ -150,6 +157,7 @@ impl SourceInfo {
             blocks: None,
             color_stated: true,
             environment: None,
+            kind: crate::env::Kind::Plain,
         }
     }
 
@@ -182,12 +190,54 @@ pub fn layout_names(format: &Format) -> Vec<String> {
 #[derive(Clone, Debug)]
 pub struct Loaded {
     /// Level 0 first; more than one entry only when the file stores mips.
+    /// For a cube map or an array, the first face or layer.
     pub levels: Vec<Texture>,
     /// Source metadata.
     pub info: SourceInfo,
+    /// The faces or layers after the first of a cube map or an array
+    /// ([`SourceInfo::kind`]), in the file's order (layer by layer, each
+    /// cube's faces +X, −X, +Y, −Y, +Z, −Z), each with as many levels as
+    /// [`Loaded::levels`]; empty for one 2-D image.
+    pub images: Vec<Vec<Texture>>,
 }
 
 impl Loaded {
+    /// One 2-D image and what the file said about it.
+    pub fn plain(levels: Vec<Texture>, info: SourceInfo) -> Self {
+        Loaded {
+            levels,
+            info,
+            images: Vec::new(),
+        }
+    }
+
+    /// Every face or layer (the first too), each its levels, level 0
+    /// first: one entry for a 2-D image.
+    pub fn into_images(self) -> Vec<Vec<Texture>> {
+        let mut all = Vec::with_capacity(1 + self.images.len());
+        all.push(self.levels);
+        all.extend(self.images);
+        all
+    }
+
+    /// Every face or layer as a mip chain: the file's own levels when it
+    /// stores them, otherwise box-filtered levels built per image (wrap
+    /// modes from the file, else repeat; a cube's faces are not joined
+    /// at their edges here, see [`crate::env::cube::build_faces`]).
+    pub fn into_image_chains(self) -> Result<Vec<MipChain>> {
+        let options = self.chain_options();
+        self.into_images()
+            .into_iter()
+            .map(|levels| {
+                if levels.len() > 1 {
+                    MipChain::from_levels(levels, options.clone())
+                } else {
+                    mip::build(levels.into_iter().next().expect("one level"), &options)
+                }
+            })
+            .collect()
+    }
+
     /// Level 0.
     pub fn base(&self) -> &Texture {
         &self.levels[0]
@@ -326,8 +376,8 @@ pub(crate) fn environment_map(
         EnvironmentMaps::Refuse => Err(Error::Decode {
             format,
             reason: format!(
-                "a {kind} environment map ({detail}), which parvo can sample by direction only: \
-                 filtering it as a flat image would blend {}",
+                "a {kind} environment map ({detail}), which parvo reads as an environment map \
+                 only: filtering it as a flat image would blend {}",
                 match kind {
                     Environment::Cube => "its six faces into each other across their edges",
                     Environment::LatLong => "across its poles as if the image repeated vertically",
@@ -336,12 +386,45 @@ pub(crate) fn environment_map(
         }),
         EnvironmentMaps::Describe => {
             notes.push(format!(
-                "{kind} environment map ({detail}): described only; parvo samples it by \
-                 direction but does not build its levels yet"
+                "{kind} environment map ({detail}): looked up by direction, its levels built \
+                 per face (cube) or weighted by solid angle (lat-long)"
             ));
             Ok(())
         }
         EnvironmentMaps::Accept => Ok(()),
+    }
+}
+
+/// Refuse a cube map or an array of `kind` (`size` its faces' or
+/// layers' level-0 size) or note it, as `options` say: read as one 2-D
+/// image it would lose every face or layer but the first.
+pub(crate) fn layered_image(
+    format: &'static str,
+    kind: crate::env::Kind,
+    (w, h): (u32, u32),
+    options: &LoadOptions,
+) -> Result<()> {
+    let what = match kind {
+        crate::env::Kind::Cube => format!("a cube map of six {w}x{h} faces"),
+        crate::env::Kind::CubeArray { cubes } => {
+            format!("an array of {cubes} cube maps ({w}x{h} faces)")
+        }
+        // One layer is all of a one-layer array.
+        crate::env::Kind::Array { layers } if layers > 1 => {
+            format!("a 2-D array of {layers} {w}x{h} layers")
+        }
+        _ => return Ok(()),
+    };
+    match options.environment {
+        EnvironmentMaps::Refuse => Err(Error::Decode {
+            format,
+            reason: format!(
+                "{what}, which this reader does not take as one 2-D image (it would keep only the \
+                 first {})",
+                if kind.is_cube() { "face" } else { "layer" }
+            ),
+        }),
+        EnvironmentMaps::Describe | EnvironmentMaps::Accept => Ok(()),
     }
 }
 
@@ -399,6 +482,35 @@ impl Default for LoadOptions {
     }
 }
 
+/// The kind of image the file at `path` holds (a cube map, an array),
+/// from its first bytes only; [`crate::env::Kind::Plain`] for every file
+/// that is neither or cannot be read (the load says why).
+pub fn peek_kind(path: &Path) -> crate::env::Kind {
+    let mut head = [0u8; 148];
+    let n = std::fs::File::open(path)
+        .and_then(|mut f| {
+            let mut n = 0;
+            while n < head.len() {
+                match f.read(&mut head[n..])? {
+                    0 => break,
+                    k => n += k,
+                }
+            }
+            Ok(n)
+        })
+        .unwrap_or(0);
+    let head = &head[..n];
+    if ktx2::Ktx2.detect(head) {
+        ktx2::peek_kind(head)
+    } else if dds::Dds.detect(head) {
+        dds::peek_kind(head)
+    } else if exr::OpenExr.detect(head) {
+        exr::peek_kind(path)
+    } else {
+        crate::env::Kind::Plain
+    }
+}
+
 /// Load a texture file or a `builtin:` name (see the module docs).
 pub fn load(spec: &str, limits: &Limits) -> Result<Loaded> {
     load_with(spec, limits, &LoadOptions::default())
@@ -428,19 +540,29 @@ pub fn load_overlapped(
 ) -> Result<Loaded> {
     let mut loaded = load_stored(spec, limits, options, overlap)?;
     if let Some(cs) = options.color {
-        loaded.levels = std::mem::take(&mut loaded.levels)
-            .into_iter()
-            .map(|l| {
-                let f = Format {
-                    color_space: cs,
-                    ..l.format()
-                };
-                l.reinterpret(f)
-            })
-            .collect::<Result<_>>()?;
+        let recolor = |levels: Vec<Texture>| {
+            levels
+                .into_iter()
+                .map(|l| {
+                    let f = Format {
+                        color_space: cs,
+                        ..l.format()
+                    };
+                    l.reinterpret(f)
+                })
+                .collect::<Result<Vec<_>>>()
+        };
+        loaded.levels = recolor(std::mem::take(&mut loaded.levels))?;
+        for image in &mut loaded.images {
+            *image = recolor(std::mem::take(image))?;
+        }
     }
     if let Some(policy) = options.nan_policy {
-        for (k, l) in loaded.levels.iter_mut().enumerate() {
+        let every = loaded
+            .images
+            .iter_mut()
+            .flat_map(|i| i.iter_mut().enumerate());
+        for (k, l) in loaded.levels.iter_mut().enumerate().chain(every) {
             crate::mip::nan::apply(l, policy).map_err(|e| match e {
                 Error::NonFinite {
                     x,
@@ -474,10 +596,7 @@ fn load_stored(
         limits.check(size as u64, size as u64, size as u64 * size as u64 * 4)?;
         let t = crate::builtin::generate(kind, size)?;
         let info = SourceInfo::new(FileFormat::Builtin, &t.format());
-        return Ok(Loaded {
-            levels: vec![t],
-            info,
-        });
+        return Ok(Loaded::plain(vec![t], info));
     }
     let path = Path::new(spec);
     let meta = std::fs::metadata(path).map_err(|e| Error::Io {

@@ -770,7 +770,7 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     // TIFF names no transfer parvo reads: its values are taken as they
     // are (linear), as OpenImageIO reads them, and that is an assumption.
     info.color_stated = false;
-    Ok(Loaded { levels, info })
+    Ok(Loaded::plain(levels, info))
 }
 
 /// The notes of walking and repairing the chain of directories: of the
