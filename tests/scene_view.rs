@@ -141,7 +141,7 @@ fn every_pixel_of_a_view_equals_the_per_pixel_formula_to_the_bit() {
                     assert_eq!(bits(scene.query(frame, tex, px, py)), want, "{what}: scene");
                     // Off the pixel grid (the flicker metric's offsets, the
                     // reference image's subsamples).
-                    let (ox, oy) = (x + 0.318, y - 0.271);
+                    let (ox, oy) = (x + 0.3125, y - 0.2703);
                     let want = uv_bits(old_uv(&scene, frame, tex, ox, oy));
                     assert_eq!(uv_bits(view.uv(ox, oy)), want, "{what}: uv");
                     assert_eq!(

@@ -6,7 +6,7 @@
 //! reports, which a cache simulation throws away; for the isotropic
 //! lookups, the bulk of a scene's cache runs, this is most of the work.
 //! [`AddressOnly`] follows the sampler's own rules for where it reads,
-//! with its LOD rules ([`Lod`], [`Plan`]: the same values, not a copy)
+//! with its LOD rules (the sampler's own `Lod` and `Plan`, not a copy)
 //! and the crate's wrap rule, and restates in a few lines only what the
 //! sampler's private filter code does with them: the 2×2 block (or the
 //! one texel) at `u·w − ½` (`u·w`), the inside-the-level test, and the
