@@ -359,6 +359,9 @@ fn a_scene_run_equals_the_plain_model_on_a_one_by_one_trace() {
             "hilbert",
             "2K:64:32:fifo",
         ),
+        ("trilinear", "rotate:17:2.2", "linear", "tiled:4", "4K:64:4"),
+        ("nearest", "zoom", "tiled:8x2", "scanline", "1K:32:2"),
+        ("bilinear", "plane", "tiled:2x2", "morton", "2K:16:4"),
     ];
     for (filter, scene, layout, order, cache) in cases {
         let sampler = Sampler::new(&chain, SamplerOptions::from_name(filter).unwrap()).unwrap();

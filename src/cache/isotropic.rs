@@ -62,6 +62,13 @@ impl AddressOnly {
     /// its order.
     #[inline]
     pub fn trace<S: TexelSink>(&self, q: &Query, sink: &mut S) {
+        self.trace_blocks(q, &mut Texels(sink));
+    }
+
+    /// [`AddressOnly::trace`] to a sink that takes a bilinear block at
+    /// once.
+    #[inline]
+    pub(crate) fn trace_blocks<S: BlockSink>(&self, q: &Query, sink: &mut S) {
         let o = &self.options;
         let plan = match o.mip {
             MipMode::None if o.mag == o.min => Plan::MAGNIFY,
@@ -78,7 +85,7 @@ impl AddressOnly {
     }
 
     #[inline(always)]
-    fn filter<S: TexelSink>(&self, magnify: bool, li: usize, u: f64, v: f64, sink: &mut S) {
+    fn filter<S: BlockSink>(&self, magnify: bool, li: usize, u: f64, v: f64, sink: &mut S) {
         let f = if magnify {
             self.options.mag
         } else {
@@ -95,7 +102,7 @@ impl AddressOnly {
 
     /// The texel `(floor(u·w), floor(v·h))`, wrapped; none for a border.
     #[inline(always)]
-    fn nearest<S: TexelSink>(
+    fn nearest<S: BlockSink>(
         &self,
         (w, h, wf, hf): (u32, u32, f64, f64),
         li: u32,
@@ -119,7 +126,7 @@ impl AddressOnly {
     /// The 2×2 texels around `(u·w − ½, v·h − ½)` in the order (i0, j0),
     /// (i1, j0), (i0, j1), (i1, j1), each axis wrapped; none for a border.
     #[inline(always)]
-    fn bilinear<S: TexelSink>(
+    fn bilinear<S: BlockSink>(
         &self,
         (w, h, wf, hf): (u32, u32, f64, f64),
         li: u32,
@@ -130,11 +137,7 @@ impl AddressOnly {
         let (_, i0) = floor_fast(u * wf - 0.5);
         let (_, j0) = floor_fast(v * hf - 0.5);
         if (i0 as u64) < (w - 1) as u64 && (j0 as u64) < (h - 1) as u64 {
-            let (x, y) = (i0 as u32, j0 as u32);
-            sink.texel(li, x, y);
-            sink.texel(li, x + 1, y);
-            sink.texel(li, x, y + 1);
-            sink.texel(li, x + 1, y + 1);
+            sink.block(li, i0 as u32, j0 as u32);
             return;
         }
         let i0 = fast_floor(reduce_coordinate(u, self.wrap.u) * wf - 0.5);
@@ -148,6 +151,31 @@ impl AddressOnly {
         }
     }
 }
+
+/// A sink that may take the 2×2 block of a bilinear lookup inside a level
+/// at once: texels `(x, y)`, `(x + 1, y)`, `(x, y + 1)`, `(x + 1, y + 1)`
+/// in that order (the default reports them one by one).
+pub(crate) trait BlockSink: TexelSink {
+    #[inline(always)]
+    fn block(&mut self, level: u32, x: u32, y: u32) {
+        self.texel(level, x, y);
+        self.texel(level, x + 1, y);
+        self.texel(level, x, y + 1);
+        self.texel(level, x + 1, y + 1);
+    }
+}
+
+/// Any sink, its blocks reported texel by texel.
+struct Texels<'a, S>(&'a mut S);
+
+impl<S: TexelSink> TexelSink for Texels<'_, S> {
+    #[inline(always)]
+    fn texel(&mut self, level: u32, x: u32, y: u32) {
+        self.0.texel(level, x, y);
+    }
+}
+
+impl<S: TexelSink> BlockSink for Texels<'_, S> {}
 
 /// 1.5·2^52: adding and subtracting it rounds an `f64` of magnitude below
 /// 2^51 to an integer.

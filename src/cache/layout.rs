@@ -484,6 +484,35 @@ impl ChainLayout {
         self.layout.offset(w, x, y)
     }
 
+    /// The address of texel `(x, y)` of level `level` and the byte steps
+    /// to `(x + 1, y)` and `(x, y + 1)`, when the 2×2 block at `(x, y)`
+    /// (inside the level) is laid out so: row-major levels, and tiles of
+    /// power-of-two sides when the block is inside one tile. `None`
+    /// otherwise (take [`ChainLayout::address`] per texel). The four
+    /// addresses grow in the block's read order, so the first and the last
+    /// tell whether all four share a cache line.
+    #[inline(always)]
+    pub fn block_steps(&self, level: u32, x: u32, y: u32) -> Option<(u64, u64, u64)> {
+        if self.block_shift != 0 {
+            return None;
+        }
+        let t = self.texel;
+        match self.fast {
+            Fast::Linear => {
+                let (w, _, base) = self.levels[level as usize];
+                Some((base + (y as u64 * w as u64 + x as u64) * t, t, w as u64 * t))
+            }
+            Fast::Tiled {
+                bx,
+                by,
+                morton: false,
+            } if (!x & ((1 << bx) - 1)) != 0 && (!y & ((1 << by) - 1)) != 0 => {
+                Some((self.address(level, x, y), t, t << bx))
+            }
+            _ => None,
+        }
+    }
+
     /// [`ChainLayout::address`] by [`Layout::offset`], the formula as
     /// SPEC.md states it (the reference the address is tested against).
     pub fn address_plain(&self, level: u32, x: u32, y: u32) -> u64 {

@@ -13,7 +13,7 @@ use std::io::{BufRead, Write};
 
 use rayon::prelude::*;
 
-use super::isotropic::AddressOnly;
+use super::isotropic::{AddressOnly, BlockSink};
 use super::layout::ChainLayout;
 use super::prefetch::{Prefetch, PrefetchStats, Timing};
 use super::sim::{AddressSpace, CacheConfig, Outcome, Simulator, Stats};
@@ -120,6 +120,33 @@ impl<'a, const ONE: bool> Recorder<'a, ONE> {
     /// Reads recorded so far (without merging).
     fn len(&self) -> usize {
         self.out.first().map_or(0, Vec::len)
+    }
+}
+
+impl<const ONE: bool> BlockSink for Recorder<'_, ONE> {
+    /// With one layout that lays the block out by steps, two addresses
+    /// (the first and the last) when the block fits one merged line: one
+    /// entry for four reads.
+    #[inline(always)]
+    fn block(&mut self, level: u32, x: u32, y: u32) {
+        if ONE && let Some((a, dx, dy)) = self.layouts[0].block_steps(level, x, y) {
+            let packed = [a, a + dx, a + dy, a + dx + dy].map(|a| pack(a, level));
+            match self.merge {
+                Some(shift) if packed[0] >> shift == packed[3] >> shift => {
+                    self.put(0, packed[0], true);
+                    // `put` of one line just made or grew the last entry.
+                    if let Some(n) = self.counts[0].last_mut() {
+                        *n += 3;
+                    }
+                }
+                _ => packed.into_iter().for_each(|p| self.put(0, p, true)),
+            }
+            return;
+        }
+        self.texel(level, x, y);
+        self.texel(level, x + 1, y);
+        self.texel(level, x, y + 1);
+        self.texel(level, x + 1, y + 1);
     }
 }
 
@@ -449,10 +476,10 @@ impl Tracer<'_> {
     /// Report the reads of `qs` to `sink`: address only when the sampler
     /// is isotropic, else by sampling (into `colours`, resized).
     #[inline]
-    fn trace<S: TexelSink>(&self, qs: &[Query], colours: &mut Vec<[f32; 4]>, sink: &mut S) {
+    fn trace<S: BlockSink>(&self, qs: &[Query], colours: &mut Vec<[f32; 4]>, sink: &mut S) {
         if let Some(a) = &self.address_only {
             for q in qs {
-                a.trace(q, sink);
+                a.trace_blocks(q, sink);
             }
             return;
         }

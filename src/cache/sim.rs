@@ -23,7 +23,7 @@
 //! queues of use stamps make every access O(1) amortised. A plain model
 //! ([`super::reference`]) is tested against both, access by access.
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::HashMap;
 use std::fmt;
 use std::str::FromStr;
 
@@ -456,7 +456,7 @@ enum Store {
         /// recent (oldest) slot. A hit is a stamp and a push, no list to
         /// relink; stale entries are skipped when a victim is sought and
         /// dropped when the queue grows past four per way.
-        queue: Vec<VecDeque<(u32, u64)>>,
+        queue: Vec<Queue>,
         clock: u64,
         fill: Vec<u32>,
     },
@@ -480,7 +480,7 @@ impl Cache {
                 line: vec![EMPTY; slots],
                 mask: vec![0; slots],
                 stamp: vec![0; slots],
-                queue: vec![VecDeque::new(); sets as usize],
+                queue: vec![Queue::default(); sets as usize],
                 clock: 0,
                 fill: vec![0; sets as usize],
             }
@@ -585,13 +585,10 @@ impl Cache {
             let missing = want & !mask[s];
             mask[s] |= want;
             // Already the most recent: nothing to reorder.
-            if policy == Policy::Lru && queue.back() != Some(&(s as u32, stamp[s])) {
+            if policy == Policy::Lru && queue.last() != Some((s as u32, stamp[s])) {
                 *clock += 1;
                 stamp[s] = *clock;
-                queue.push_back((s as u32, *clock));
-                if queue.len() > 4 * ways + 16 {
-                    queue.retain(|&(k, t)| stamp[k as usize] == t);
-                }
+                queue.push((s as u32, *clock), ways, stamp);
             }
             return (missing, mask[s]);
         }
@@ -604,15 +601,7 @@ impl Cache {
             index.set(lines[victim], NONE);
             victim
         } else {
-            // The first live entry: the least recent (oldest) slot. A
-            // full set has one live entry per slot, so one is found.
-            let victim = loop {
-                match queue.pop_front() {
-                    Some((k, t)) if stamp[k as usize] == t => break k as usize,
-                    Some(_) => {}
-                    None => unreachable!("a full set has a live entry per slot"),
-                }
-            };
+            let victim = queue.pop_oldest(stamp);
             index.set(lines[victim], NONE);
             victim
         };
@@ -622,9 +611,64 @@ impl Cache {
         if policy != Policy::Random {
             *clock += 1;
             stamp[slot] = *clock;
-            queue.push_back((slot as u32, *clock));
+            queue.push((slot as u32, *clock), ways, stamp);
         }
         (want, want)
+    }
+}
+
+/// One set's (slot, stamp) entries in the order of use, from `head` on
+/// (see `Store::Large`).
+#[derive(Clone, Debug, Default)]
+struct Queue {
+    entries: Vec<(u32, u64)>,
+    head: usize,
+}
+
+impl Queue {
+    #[inline(always)]
+    fn last(&self) -> Option<(u32, u64)> {
+        self.entries.last().copied()
+    }
+
+    /// Append an entry; past four entries per way (and a few) in the
+    /// queue, or as many popped ones before it, keep only the live ones
+    /// (in order): the memory stays within a few entries per way.
+    #[inline(always)]
+    fn push(&mut self, e: (u32, u64), ways: usize, stamp: &[u64]) {
+        self.entries.push(e);
+        let limit = 4 * ways + 16;
+        if self.entries.len() - self.head > limit || self.head > limit {
+            self.compact(stamp);
+        }
+    }
+
+    #[inline(never)]
+    fn compact(&mut self, stamp: &[u64]) {
+        let mut j = 0;
+        for i in self.head..self.entries.len() {
+            let (k, t) = self.entries[i];
+            if stamp[k as usize] == t {
+                self.entries[j] = (k, t);
+                j += 1;
+            }
+        }
+        self.entries.truncate(j);
+        self.head = 0;
+    }
+
+    /// Remove and return the oldest live slot. A full set has a live
+    /// entry per slot; an empty queue (which a full set never has) gives
+    /// slot 0 rather than a panic.
+    #[inline(always)]
+    fn pop_oldest(&mut self, stamp: &[u64]) -> usize {
+        while let Some(&(k, t)) = self.entries.get(self.head) {
+            self.head += 1;
+            if stamp[k as usize] == t {
+                return k as usize;
+            }
+        }
+        0
     }
 }
 
