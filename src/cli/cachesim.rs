@@ -10,6 +10,10 @@
 //!   scene's reads in that format;
 //! - `--sweep`: a grid of cache sizes, line sizes, associativities,
 //!   layouts and filters, in parallel, to `DIR/sweep.csv` and an SVG plot.
+//!
+//! Scene runs and sweeps take `--quads` (a 2×2 quad's reads of one line
+//! are one request); scene runs take `--prefetch` (the misses timed in a
+//! prefetching texture unit, `parvo::cache::prefetch`).
 
 use std::fs::File;
 use std::io::{BufReader, IsTerminal, Write};
@@ -42,7 +46,8 @@ use parvo::scene::{Frame, RasterOrder, Scene};
     bytes that reach memory, in total and per mip level.\n\n\
     Modes: scene (default); --trace FILE (an address trace, one decimal or 0x-hex address per line, \
     `#` comments; - for stdin); --sweep (a grid of caches × layouts × filters to --out DIR as CSV \
-    and SVG).\n\n\
+    and SVG). --quads issues 2x2 quads whose reads of one line merge; --prefetch times the misses \
+    in a prefetching texture unit.\n\n\
     Cache spec: SIZE:LINE:WAYS[:POLICY], SIZE as 16384, 16K, 16KiB or 4M, WAYS a number or `full`, \
     POLICY lru (default), fifo or random. Layouts: linear, tiled:WxH, morton, morton:WxH, \
     blocked:WxH:SWxSH. Orders: scanline, tiled:N, morton, hilbert. Scenes: plane, tunnel, zoom, \
