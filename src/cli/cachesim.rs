@@ -153,6 +153,7 @@ pub struct CachesimArgs {
         long,
         value_delimiter = ',',
         value_name = "DEPTHS",
+        value_parser = clap::value_parser!(u32).range(0..=1 << 20),
         conflicts_with = "sweep",
         long_help = "Time the cache's misses in a prefetching texture unit after Igehy, Eldridge \
         and Proudfoot (1998): tags are looked up when a fragment (a pixel, or a quad with --quads) \
@@ -162,20 +163,22 @@ pub struct CachesimArgs {
         the FIFO recovers. See --latency and --request-cycles."
     )]
     prefetch: Vec<u32>,
-    /// Prefetching: memory latency in cycles.
+    /// Prefetching: memory latency in cycles (up to a million).
     #[arg(
         long,
         value_name = "CYCLES",
         default_value_t = 200,
-        requires = "prefetch"
+        requires = "prefetch",
+        value_parser = clap::value_parser!(u32).range(0..=1_000_000)
     )]
     latency: u32,
-    /// Prefetching: cycles per line request (the memory's bandwidth).
+    /// Prefetching: cycles per line request (the memory's bandwidth), at least 1.
     #[arg(
         long,
         value_name = "CYCLES",
         default_value_t = 1,
-        requires = "prefetch"
+        requires = "prefetch",
+        value_parser = clap::value_parser!(u32).range(1..)
     )]
     request_cycles: u32,
 }
@@ -344,9 +347,9 @@ fn model(args: &CachesimArgs) -> std::result::Result<Model, String> {
             request_cycles: args.request_cycles,
         })
         .collect();
+    // The arguments' ranges are the model's: this only guards them.
     for t in &prefetch {
-        t.validate()
-            .map_err(|e| format!("--prefetch: {}", super::words(e)))?;
+        t.validate().map_err(|e| super::words(e).to_string())?;
     }
     Ok(Model {
         quads: args.quads,
