@@ -78,6 +78,7 @@ pub mod builtin;
 pub mod cache;
 pub mod compress;
 mod cpu;
+pub mod env;
 pub mod error;
 #[cfg(feature = "io")]
 pub mod io;

@@ -19,6 +19,10 @@ import numpy as np
 
 # GL enums (OpenGL 4.5 core, glcorearb.h).
 TEXTURE_2D = 0x0DE1
+TEXTURE_CUBE_MAP = 0x8513
+TEXTURE_CUBE_MAP_POSITIVE_X = 0x8515  # + face index: +X -X +Y -Y +Z -Z
+TEXTURE_CUBE_MAP_SEAMLESS = 0x884F
+TEXTURE_MAX_ANISOTROPY = 0x84FE
 TEXTURE0 = 0x84C0
 FLOAT = 0x1406
 RGBA = 0x1908
@@ -106,6 +110,7 @@ class GL:
         self.SamplerParameterf = fn("glSamplerParameterf", u, u, f)
         self.SamplerParameterfv = fn("glSamplerParameterfv", u, u, ctypes.POINTER(f))
         self.GetError = fn("glGetError", restype=u)
+        self.Enable = fn("glEnable", u)
         self.programs = {}
 
     def check_error(self, what):
@@ -137,6 +142,66 @@ class GL:
         self.check_error("texture levels")
         self.ActiveTexture(TEXTURE0)
         return name.value
+
+    def cube_texture(self, faces):
+        """A cube map on unit 0: faces[f][k] is face f's level k (H x W x 4
+        float32, faces in GL's order +X -X +Y -Y +Z -Z), with seamless
+        filtering on (GL_TEXTURE_CUBE_MAP_SEAMLESS, off by default in GL)."""
+        name = ctypes.c_uint(0)
+        self.GenTextures(1, ctypes.byref(name))
+        self.ActiveTexture(TEXTURE0)
+        self.BindTexture(TEXTURE_CUBE_MAP, name.value)
+        self.PixelStorei(UNPACK_ALIGNMENT, 1)
+        for f, levels in enumerate(faces):
+            for k, lv in enumerate(levels):
+                a = np.ascontiguousarray(lv, dtype=np.float32)
+                h, w = a.shape[:2]
+                self.TexImage2D(TEXTURE_CUBE_MAP_POSITIVE_X + f, k, RGBA32F, w, h, 0, RGBA, FLOAT,
+                                a.ctypes.data)
+                self.check_error(f"glTexImage2D face {f} level {k}")
+        self.TexParameteri(TEXTURE_CUBE_MAP, TEXTURE_BASE_LEVEL, 0)
+        self.TexParameteri(TEXTURE_CUBE_MAP, TEXTURE_MAX_LEVEL, len(faces[0]) - 1)
+        self.Enable(TEXTURE_CUBE_MAP_SEAMLESS)
+        self.check_error("cube texture")
+        return name.value
+
+    def run_cube(self, queries, max_aniso=1.0):
+        """textureGrad(samplerCube) for N queries (N x 9 float32: direction,
+        its x derivative, its y derivative) on the cube bound to unit 0 (the
+        sampler bound there, its max anisotropy set to `max_aniso`);
+        returns N x 4 float32."""
+        key = "cube grad"
+        if key not in self.programs:
+            self.programs[key] = self.ctx.compute_shader("""#version 450
+layout(local_size_x = 64) in;
+layout(binding = 0) uniform samplerCube tex;
+layout(std430, binding = 0) readonly buffer Queries { float q[]; };
+layout(std430, binding = 1) writeonly buffer Results { vec4 r[]; };
+uniform uint count;
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= count) return;
+    uint b = 9u * i;
+    vec3 d = vec3(q[b], q[b + 1u], q[b + 2u]);
+    vec3 dx = vec3(q[b + 3u], q[b + 4u], q[b + 5u]);
+    vec3 dy = vec3(q[b + 6u], q[b + 7u], q[b + 8u]);
+    r[i] = textureGrad(tex, d, dx, dy);
+}
+""")
+        prog = self.programs[key]
+        q = np.ascontiguousarray(queries, dtype=np.float32)
+        n = len(q)
+        qbuf = self.ctx.buffer(q.tobytes())
+        rbuf = self.ctx.buffer(reserve=max(16, n * 16))
+        qbuf.bind_to_storage_buffer(0)
+        rbuf.bind_to_storage_buffer(1)
+        prog["count"].value = n
+        prog.run(group_x=(n + 63) // 64)
+        out = np.frombuffer(rbuf.read(), dtype=np.float32)[: n * 4].reshape(n, 4).copy()
+        qbuf.release()
+        rbuf.release()
+        self.check_error("compute cube grad")
+        return out
 
     def bind(self, name):
         """Bind texture `name` to unit 0, where every lookup samples."""
@@ -171,6 +236,11 @@ class GL:
         self.check_error("sampler parameters")
         self.BindSampler(0, s)
         return s
+
+    def set_max_anisotropy(self, sampler, n):
+        """GL 4.6 / EXT_texture_filter_anisotropic maximum anisotropy."""
+        self.SamplerParameterf(sampler, TEXTURE_MAX_ANISOTROPY, float(n))
+        self.check_error("max anisotropy")
 
     def delete_sampler(self, name):
         n = ctypes.c_uint(name)
@@ -320,3 +390,30 @@ def fragment_derivatives(queries):
     q[:, 2:4] = (uv + q[:, 2:4]) - uv
     q[:, 4:6] = (uv + q[:, 4:6]) - uv
     return q
+
+
+def gl_setup():
+    """Mesa's llvmpipe through EGL, installed by scripts/setup-gl.sh; None
+    after a "skip:" line when the packages cannot be installed here (or a
+    "FAIL:" line when they are there but give no llvmpipe context)."""
+    import subprocess
+    from pathlib import Path
+
+    from common import check
+
+    root = Path(__file__).resolve().parents[2]
+    r = subprocess.run(["bash", str(root / "scripts/setup-gl.sh")], capture_output=True, text=True)
+    if r.returncode == 3:
+        print(r.stdout.strip() or "skip: llvmpipe checks (scripts/setup-gl.sh cannot install Mesa)", flush=True)
+        return None
+    if r.returncode != 0:
+        check(False, "scripts/setup-gl.sh installs Mesa's EGL and llvmpipe", (r.stdout + r.stderr).strip())
+        return None
+    try:
+        gl = GL()
+    except Exception as e:  # the context is the whole point: say why it failed
+        check(False, "an off-screen OpenGL 4.5 context on Mesa's EGL", f"{type(e).__name__}: {e}")
+        return None
+    if not check("llvmpipe" in gl.renderer, "the GL context is Mesa's llvmpipe", f"{gl.renderer}, {gl.version}"):
+        return None
+    return gl

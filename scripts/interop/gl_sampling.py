@@ -64,7 +64,7 @@ import OpenImageIO as oiio
 sys.dont_write_bytecode = True  # no __pycache__ of the helper modules in the checkout
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _glmodel as model  # noqa: E402
-from _llvmpipe import fragment_derivatives  # noqa: E402  (numpy only; GL loads on use)
+from _llvmpipe import fragment_derivatives, gl_setup  # noqa: E402  (numpy only; GL loads on use)
 from common import args, check, finish, oiio_levels, skip  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -91,28 +91,6 @@ SHADER_BIASES = [0.3, -1.37, 2.2]
 TOL = 2e-5
 N = 1200
 MAX_SHOWN = 4
-
-
-def gl_setup():
-    """Mesa's llvmpipe through EGL, installed by scripts/setup-gl.sh; None
-    after a "skip:" line when the packages cannot be installed here."""
-    r = subprocess.run(["bash", str(ROOT / "scripts/setup-gl.sh")], capture_output=True, text=True)
-    if r.returncode == 3:
-        print(r.stdout.strip() or "skip: llvmpipe checks (scripts/setup-gl.sh cannot install Mesa)", flush=True)
-        return None
-    if r.returncode != 0:
-        check(False, "scripts/setup-gl.sh installs Mesa's EGL and llvmpipe", (r.stdout + r.stderr).strip())
-        return None
-    from _llvmpipe import GL
-
-    try:
-        gl = GL()
-    except Exception as e:  # the context is the whole point: say why it failed
-        check(False, "an off-screen OpenGL 4.5 context on Mesa's EGL", f"{type(e).__name__}: {e}")
-        return None
-    if not check("llvmpipe" in gl.renderer, "the GL context is Mesa's llvmpipe", f"{gl.renderer}, {gl.version}"):
-        return None
-    return gl
 
 
 # --- parvo's side: the only code that knows `parvo sample`'s command line ---

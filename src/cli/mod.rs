@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cachesim;
+mod env;
 mod images;
 mod info;
 mod mip;

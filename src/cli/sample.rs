@@ -130,6 +130,29 @@ pub struct SampleArgs {
         for fixed-point depth."
     )]
     compare: Option<CompareOp>,
+    /// Queries are directions: `x y z dxdx dydx dzdx dxdy dydy dzdy` per line.
+    #[arg(
+        long,
+        conflicts_with_all = ["gather", "compare", "level", "bias"],
+        long_help = "Each query line is a direction and its screen derivatives, `x y z dxdx dydx \
+        dzdx dxdy dydy dzdy` (as dFdx/dFdy of a reflection vector give them), looked up in the \
+        environment the file records (maketx's and OpenEXR's lat-long and cube-face maps) or \
+        --env says it holds. Cube maps are filtered seamlessly across face \
+        edges (GL's ARB_seamless_cube_map, every filter); lat-long maps as OpenImageIO's \
+        environment() filters them."
+    )]
+    direction: bool,
+    /// The environment the texture holds: latlong, or cube (a w x 6w strip of faces).
+    #[arg(
+        long,
+        value_name = "KIND",
+        requires = "direction",
+        long_help = "The environment the texture holds. latlong: an equirectangular map, y up, \
+        s = atan2(-x, z)/2pi + 1/2 (OpenImageIO's convention). cube: a vertical strip of six \
+        square faces, w x 6w, +x -x +y -y +z -z from the top (OpenEXR's cube-map layout, as \
+        maketx --envcube writes it), each face mip-mapped on its own."
+    )]
+    env: Option<super::env::EnvArg>,
 }
 
 /// What `parvo sample` computes per query.
@@ -214,6 +237,19 @@ pub fn run(args: SampleArgs) -> Result<ExitCode> {
     if let Err(e) = options.validate() {
         eprintln!("parvo: {}", super::words(&e));
         return Ok(ExitCode::from(2));
+    }
+    if args.direction {
+        let env = args.env;
+        let out = BufWriter::with_capacity(1 << 16, io::stdout().lock());
+        super::env::run(
+            &args.read,
+            &args.texture,
+            env,
+            options,
+            io::stdin().lock(),
+            out,
+        )?;
+        return Ok(ExitCode::SUCCESS);
     }
     // A mip-mapped EXR/KTX2/DDS keeps its own levels; anything else gets
     // box mips built on load.
@@ -341,7 +377,7 @@ fn stream(
 }
 
 /// One line of output: the texture's channels of an RGBA colour.
-fn format_colour(s: &mut String, c: &[f32; 4], channels: usize) {
+pub(super) fn format_colour(s: &mut String, c: &[f32; 4], channels: usize) {
     use std::fmt::Write as _;
     let vals: &[f32] = match channels {
         1 => &c[..1],

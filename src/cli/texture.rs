@@ -58,7 +58,22 @@ impl TextureArgs {
     /// Load `spec`, printing the loader's notes (and its colour assumption
     /// under `--color auto`) on stderr.
     pub fn load(&self, spec: &str) -> Result<Loaded> {
-        let loaded = io::load_with(spec, &Limits::default(), &self.options())
+        self.load_as(spec, self.options())
+    }
+
+    /// [`Self::load`] for a direction lookup: an environment map (a
+    /// maketx or OpenEXR lat-long or cube-face file) is loaded as one,
+    /// marked in [`io::SourceInfo::environment`], not refused.
+    pub fn load_environment(&self, spec: &str) -> Result<Loaded> {
+        let options = LoadOptions {
+            environment: io::EnvironmentMaps::Accept,
+            ..self.options()
+        };
+        self.load_as(spec, options)
+    }
+
+    fn load_as(&self, spec: &str, options: LoadOptions) -> Result<Loaded> {
+        let loaded = io::load_with(spec, &Limits::default(), &options)
             .map_err(super::with_hint)
             .with_context(|| format!("cannot read texture `{spec}`"))?;
         let assumed = (self.color == ColorArg::Auto)

@@ -688,133 +688,136 @@ const DXGI_BLOCKS: [(u32, BlockFormat, bool); 21] = {
     ]
 };
 
+/// Microsoft's `DXGI_FORMAT_*` enumerants without the prefix, by value
+/// (every value DXGI defines; the gaps 116-129 and 133-188 are unused).
+const DXGI_NAMES: [(u32, &str); 121] = [
+    (0, "UNKNOWN"),
+    (1, "R32G32B32A32_TYPELESS"),
+    (2, "R32G32B32A32_FLOAT"),
+    (3, "R32G32B32A32_UINT"),
+    (4, "R32G32B32A32_SINT"),
+    (5, "R32G32B32_TYPELESS"),
+    (6, "R32G32B32_FLOAT"),
+    (7, "R32G32B32_UINT"),
+    (8, "R32G32B32_SINT"),
+    (9, "R16G16B16A16_TYPELESS"),
+    (10, "R16G16B16A16_FLOAT"),
+    (11, "R16G16B16A16_UNORM"),
+    (12, "R16G16B16A16_UINT"),
+    (13, "R16G16B16A16_SNORM"),
+    (14, "R16G16B16A16_SINT"),
+    (15, "R32G32_TYPELESS"),
+    (16, "R32G32_FLOAT"),
+    (17, "R32G32_UINT"),
+    (18, "R32G32_SINT"),
+    (19, "R32G8X24_TYPELESS"),
+    (20, "D32_FLOAT_S8X24_UINT"),
+    (21, "R32_FLOAT_X8X24_TYPELESS"),
+    (22, "X32_TYPELESS_G8X24_UINT"),
+    (23, "R10G10B10A2_TYPELESS"),
+    (24, "R10G10B10A2_UNORM"),
+    (25, "R10G10B10A2_UINT"),
+    (26, "R11G11B10_FLOAT"),
+    (27, "R8G8B8A8_TYPELESS"),
+    (28, "R8G8B8A8_UNORM"),
+    (29, "R8G8B8A8_UNORM_SRGB"),
+    (30, "R8G8B8A8_UINT"),
+    (31, "R8G8B8A8_SNORM"),
+    (32, "R8G8B8A8_SINT"),
+    (33, "R16G16_TYPELESS"),
+    (34, "R16G16_FLOAT"),
+    (35, "R16G16_UNORM"),
+    (36, "R16G16_UINT"),
+    (37, "R16G16_SNORM"),
+    (38, "R16G16_SINT"),
+    (39, "R32_TYPELESS"),
+    (40, "D32_FLOAT"),
+    (41, "R32_FLOAT"),
+    (42, "R32_UINT"),
+    (43, "R32_SINT"),
+    (44, "R24G8_TYPELESS"),
+    (45, "D24_UNORM_S8_UINT"),
+    (46, "R24_UNORM_X8_TYPELESS"),
+    (47, "X24_TYPELESS_G8_UINT"),
+    (48, "R8G8_TYPELESS"),
+    (49, "R8G8_UNORM"),
+    (50, "R8G8_UINT"),
+    (51, "R8G8_SNORM"),
+    (52, "R8G8_SINT"),
+    (53, "R16_TYPELESS"),
+    (54, "R16_FLOAT"),
+    (55, "D16_UNORM"),
+    (56, "R16_UNORM"),
+    (57, "R16_UINT"),
+    (58, "R16_SNORM"),
+    (59, "R16_SINT"),
+    (60, "R8_TYPELESS"),
+    (61, "R8_UNORM"),
+    (62, "R8_UINT"),
+    (63, "R8_SNORM"),
+    (64, "R8_SINT"),
+    (65, "A8_UNORM"),
+    (66, "R1_UNORM"),
+    (67, "R9G9B9E5_SHAREDEXP"),
+    (68, "R8G8_B8G8_UNORM"),
+    (69, "G8R8_G8B8_UNORM"),
+    (70, "BC1_TYPELESS"),
+    (71, "BC1_UNORM"),
+    (72, "BC1_UNORM_SRGB"),
+    (73, "BC2_TYPELESS"),
+    (74, "BC2_UNORM"),
+    (75, "BC2_UNORM_SRGB"),
+    (76, "BC3_TYPELESS"),
+    (77, "BC3_UNORM"),
+    (78, "BC3_UNORM_SRGB"),
+    (79, "BC4_TYPELESS"),
+    (80, "BC4_UNORM"),
+    (81, "BC4_SNORM"),
+    (82, "BC5_TYPELESS"),
+    (83, "BC5_UNORM"),
+    (84, "BC5_SNORM"),
+    (85, "B5G6R5_UNORM"),
+    (86, "B5G5R5A1_UNORM"),
+    (87, "B8G8R8A8_UNORM"),
+    (88, "B8G8R8X8_UNORM"),
+    (89, "R10G10B10_XR_BIAS_A2_UNORM"),
+    (90, "B8G8R8A8_TYPELESS"),
+    (91, "B8G8R8A8_UNORM_SRGB"),
+    (92, "B8G8R8X8_TYPELESS"),
+    (93, "B8G8R8X8_UNORM_SRGB"),
+    (94, "BC6H_TYPELESS"),
+    (95, "BC6H_UF16"),
+    (96, "BC6H_SF16"),
+    (97, "BC7_TYPELESS"),
+    (98, "BC7_UNORM"),
+    (99, "BC7_UNORM_SRGB"),
+    (100, "AYUV"),
+    (101, "Y410"),
+    (102, "Y416"),
+    (103, "NV12"),
+    (104, "P010"),
+    (105, "P016"),
+    (106, "OPAQUE_420"),
+    (107, "YUY2"),
+    (108, "Y210"),
+    (109, "Y216"),
+    (110, "NV11"),
+    (111, "AI44"),
+    (112, "IA44"),
+    (113, "P8"),
+    (114, "A8P8"),
+    (115, "B4G4R4A4_UNORM"),
+    (130, "P208"),
+    (131, "V208"),
+    (132, "V408"),
+    (189, "SAMPLER_FEEDBACK_MIN_MIP_OPAQUE"),
+    (190, "SAMPLER_FEEDBACK_MIP_REGION_USED_OPAQUE"),
+];
+
 /// The name of a `DXGI_FORMAT` value (Microsoft's `DXGI_FORMAT_*`
 /// enumerants without the prefix), `None` for values it does not define.
 pub fn dxgi_name(v: u32) -> Option<&'static str> {
-    Some(match v {
-        0 => "UNKNOWN",
-        1 => "R32G32B32A32_TYPELESS",
-        2 => "R32G32B32A32_FLOAT",
-        3 => "R32G32B32A32_UINT",
-        4 => "R32G32B32A32_SINT",
-        5 => "R32G32B32_TYPELESS",
-        6 => "R32G32B32_FLOAT",
-        7 => "R32G32B32_UINT",
-        8 => "R32G32B32_SINT",
-        9 => "R16G16B16A16_TYPELESS",
-        10 => "R16G16B16A16_FLOAT",
-        11 => "R16G16B16A16_UNORM",
-        12 => "R16G16B16A16_UINT",
-        13 => "R16G16B16A16_SNORM",
-        14 => "R16G16B16A16_SINT",
-        15 => "R32G32_TYPELESS",
-        16 => "R32G32_FLOAT",
-        17 => "R32G32_UINT",
-        18 => "R32G32_SINT",
-        19 => "R32G8X24_TYPELESS",
-        20 => "D32_FLOAT_S8X24_UINT",
-        21 => "R32_FLOAT_X8X24_TYPELESS",
-        22 => "X32_TYPELESS_G8X24_UINT",
-        23 => "R10G10B10A2_TYPELESS",
-        24 => "R10G10B10A2_UNORM",
-        25 => "R10G10B10A2_UINT",
-        26 => "R11G11B10_FLOAT",
-        27 => "R8G8B8A8_TYPELESS",
-        28 => "R8G8B8A8_UNORM",
-        29 => "R8G8B8A8_UNORM_SRGB",
-        30 => "R8G8B8A8_UINT",
-        31 => "R8G8B8A8_SNORM",
-        32 => "R8G8B8A8_SINT",
-        33 => "R16G16_TYPELESS",
-        34 => "R16G16_FLOAT",
-        35 => "R16G16_UNORM",
-        36 => "R16G16_UINT",
-        37 => "R16G16_SNORM",
-        38 => "R16G16_SINT",
-        39 => "R32_TYPELESS",
-        40 => "D32_FLOAT",
-        41 => "R32_FLOAT",
-        42 => "R32_UINT",
-        43 => "R32_SINT",
-        44 => "R24G8_TYPELESS",
-        45 => "D24_UNORM_S8_UINT",
-        46 => "R24_UNORM_X8_TYPELESS",
-        47 => "X24_TYPELESS_G8_UINT",
-        48 => "R8G8_TYPELESS",
-        49 => "R8G8_UNORM",
-        50 => "R8G8_UINT",
-        51 => "R8G8_SNORM",
-        52 => "R8G8_SINT",
-        53 => "R16_TYPELESS",
-        54 => "R16_FLOAT",
-        55 => "D16_UNORM",
-        56 => "R16_UNORM",
-        57 => "R16_UINT",
-        58 => "R16_SNORM",
-        59 => "R16_SINT",
-        60 => "R8_TYPELESS",
-        61 => "R8_UNORM",
-        62 => "R8_UINT",
-        63 => "R8_SNORM",
-        64 => "R8_SINT",
-        65 => "A8_UNORM",
-        66 => "R1_UNORM",
-        67 => "R9G9B9E5_SHAREDEXP",
-        68 => "R8G8_B8G8_UNORM",
-        69 => "G8R8_G8B8_UNORM",
-        70 => "BC1_TYPELESS",
-        71 => "BC1_UNORM",
-        72 => "BC1_UNORM_SRGB",
-        73 => "BC2_TYPELESS",
-        74 => "BC2_UNORM",
-        75 => "BC2_UNORM_SRGB",
-        76 => "BC3_TYPELESS",
-        77 => "BC3_UNORM",
-        78 => "BC3_UNORM_SRGB",
-        79 => "BC4_TYPELESS",
-        80 => "BC4_UNORM",
-        81 => "BC4_SNORM",
-        82 => "BC5_TYPELESS",
-        83 => "BC5_UNORM",
-        84 => "BC5_SNORM",
-        85 => "B5G6R5_UNORM",
-        86 => "B5G5R5A1_UNORM",
-        87 => "B8G8R8A8_UNORM",
-        88 => "B8G8R8X8_UNORM",
-        89 => "R10G10B10_XR_BIAS_A2_UNORM",
-        90 => "B8G8R8A8_TYPELESS",
-        91 => "B8G8R8A8_UNORM_SRGB",
-        92 => "B8G8R8X8_TYPELESS",
-        93 => "B8G8R8X8_UNORM_SRGB",
-        94 => "BC6H_TYPELESS",
-        95 => "BC6H_UF16",
-        96 => "BC6H_SF16",
-        97 => "BC7_TYPELESS",
-        98 => "BC7_UNORM",
-        99 => "BC7_UNORM_SRGB",
-        100 => "AYUV",
-        101 => "Y410",
-        102 => "Y416",
-        103 => "NV12",
-        104 => "P010",
-        105 => "P016",
-        106 => "OPAQUE_420",
-        107 => "YUY2",
-        108 => "Y210",
-        109 => "Y216",
-        110 => "NV11",
-        111 => "AI44",
-        112 => "IA44",
-        113 => "P8",
-        114 => "A8P8",
-        115 => "B4G4R4A4_UNORM",
-        130 => "P208",
-        131 => "V208",
-        132 => "V408",
-        189 => "SAMPLER_FEEDBACK_MIN_MIP_OPAQUE",
-        190 => "SAMPLER_FEEDBACK_MIP_REGION_USED_OPAQUE",
-        _ => return None,
-    })
+    DXGI_NAMES.iter().find(|e| e.0 == v).map(|e| e.1)
 }
 
 /// `NAME (n)`, or the number alone when DXGI defines no such format.
@@ -863,145 +866,199 @@ fn fourcc_text(v: u32) -> String {
     }
 }
 
+/// DirectDraw's palette flags (ddraw.h `DDPF_PALETTEINDEXED*`) and the
+/// index width each names: texels are indices into a palette stored after
+/// the header.
+const PALETTE_FLAGS: [(u32, &str); 5] = [
+    (0x800, "1-bit"),
+    (0x1000, "2-bit"),
+    (0x8, "4-bit"),
+    (0x20, "8-bit"),
+    (0x10, ""),
+];
+
+/// Block formats named by a fourCC: code, format, alpha (`DXT2` and `DXT4`
+/// are the premultiplied `DXT3` and `DXT5`).
+const FOURCC_BLOCKS: [(&[u8; 4], BlockFormat, AlphaMode); 11] = {
+    use AlphaMode::{Premultiplied, Straight};
+    use BlockFormat::*;
+    [
+        (b"DXT1", Bc1, Straight),
+        (b"DXT2", Bc2, Premultiplied),
+        (b"DXT3", Bc2, Straight),
+        (b"DXT4", Bc3, Premultiplied),
+        (b"DXT5", Bc3, Straight),
+        (b"ATI1", Bc4 { signed: false }, Straight),
+        (b"BC4U", Bc4 { signed: false }, Straight),
+        (b"BC4S", Bc4 { signed: true }, Straight),
+        (b"ATI2", Bc5 { signed: false }, Straight),
+        (b"BC5U", Bc5 { signed: false }, Straight),
+        (b"BC5S", Bc5 { signed: true }, Straight),
+    ]
+};
+
+/// Uncompressed formats named by a D3DX fourCC number (`D3DFMT_*`, see
+/// [`fourcc_text`]): code, channels, type; linear, two channels are R, G
+/// data.
+const FOURCC_PLAIN: [(u32, u8, ChannelType); 7] = {
+    use ChannelType::*;
+    [
+        (36, 4, U16),
+        (111, 1, F16),
+        (112, 2, F16),
+        (113, 4, F16),
+        (114, 1, F32),
+        (115, 2, F32),
+        (116, 4, F32),
+    ]
+};
+
 /// What the header says is stored, and a description for `parvo info`.
 fn stored_of(h: &Header) -> Result<(Stored, String)> {
-    use ChannelType::*;
     let pf = &h.pixel_format;
-    let lin = ColorSpace::Linear;
-    let plain = |format: Format, bytes: usize| Stored::Plain {
-        format,
-        bytes,
-        masks: None,
-        swap_rb: false,
-        drop_alpha: false,
-    };
-    let blocks = |format: BlockFormat, alpha: AlphaMode| Stored::Blocks {
-        format,
-        srgb: false,
-        alpha,
-    };
     if let Some(d) = &h.dx10 {
-        let mode = d.misc_flags2 & 7;
-        if let Some(&(_, bf, srgb)) = DXGI_BLOCKS.iter().find(|e| e.0 == d.dxgi_format) {
-            let alpha = match mode {
-                alpha_mode::PREMULTIPLIED => AlphaMode::Premultiplied,
-                alpha_mode::OPAQUE => AlphaMode::None,
-                _ => AlphaMode::Straight,
-            };
-            return Ok((
-                Stored::Blocks {
-                    format: bf,
-                    srgb,
-                    alpha,
-                },
-                format!(
-                    "DX10 {}",
-                    dxgi_name(d.dxgi_format).unwrap_or(if srgb { "sRGB" } else { "" })
-                ),
-            ));
-        }
-        let &(_, ch, ty, srgb, swap, padded, name) = DXGI_PLAIN
-            .iter()
-            .find(|e| e.0 == d.dxgi_format)
-            .ok_or_else(|| {
-                decode_err(format!(
-                    "DXGI format {} is not one parvo reads (it reads the uncompressed UNORM 8-bit \
-                     and 16-bit, half and float R/RG/RGB/RGBA/BGRA formats and BC1-BC7)",
-                    dxgi_describe(d.dxgi_format)
-                ))
-            })?;
-        let cs = if srgb { ColorSpace::Srgb } else { lin };
-        let mut format = Format::new(ch, ty, cs);
-        let mut drop_alpha = padded;
-        match (ch, mode) {
-            (2, alpha_mode::STRAIGHT) => {}
-            (2, alpha_mode::PREMULTIPLIED) | (4, alpha_mode::PREMULTIPLIED) => {
-                format = format.with_alpha(AlphaMode::Premultiplied)
-            }
-            (2, _) => format = format.with_alpha(AlphaMode::None),
-            (4, alpha_mode::OPAQUE) => drop_alpha = true,
-            (4, alpha_mode::CUSTOM) => format = format.with_alpha(AlphaMode::None),
-            _ => {}
-        }
-        let bytes = ch as usize * ty.bytes();
-        if drop_alpha {
-            format.channels = 3;
-        }
-        return Ok((
-            Stored::Plain {
-                format,
-                bytes,
-                masks: None,
-                swap_rb: swap,
-                drop_alpha,
-            },
-            format!("DX10 {name}"),
-        ));
+        return stored_of_dx10(d);
     }
-    // DirectDraw's palette flags (ddraw.h `DDPF_PALETTEINDEXED*`): texels
-    // are indices into a palette stored after the header.
-    let palette = [
-        (0x800, "1-bit"),
-        (0x1000, "2-bit"),
-        (0x8, "4-bit"),
-        (0x20, "8-bit"),
-        (0x10, ""),
-    ]
-    .iter()
-    .find(|(flag, _)| pf.flags & flag != 0);
-    if let Some((_, bits)) = palette {
-        return Err(decode_err(format!(
-            "this is a palettised DDS ({}palette indices, pixel format flags {:#x}), which parvo \
-             does not read",
-            if bits.is_empty() {
-                String::new()
-            } else {
-                format!("{bits} ")
-            },
-            pf.flags
-        )));
-    }
+    refuse_palette(pf)?;
     if pf.flags & ddpf::FOURCC != 0 {
-        let code = pf.fourcc;
-        if code == 0 {
-            return Err(decode_err(
-                "the pixel format says a fourCC names the format, but the fourCC is empty (0)",
-            ));
-        }
-        let st = match &code.to_le_bytes() {
-            b"DXT1" => blocks(BlockFormat::Bc1, AlphaMode::Straight),
-            b"DXT2" => blocks(BlockFormat::Bc2, AlphaMode::Premultiplied),
-            b"DXT3" => blocks(BlockFormat::Bc2, AlphaMode::Straight),
-            b"DXT4" => blocks(BlockFormat::Bc3, AlphaMode::Premultiplied),
-            b"DXT5" => blocks(BlockFormat::Bc3, AlphaMode::Straight),
-            b"ATI1" | b"BC4U" => blocks(BlockFormat::Bc4 { signed: false }, AlphaMode::Straight),
-            b"BC4S" => blocks(BlockFormat::Bc4 { signed: true }, AlphaMode::Straight),
-            b"ATI2" | b"BC5U" => blocks(BlockFormat::Bc5 { signed: false }, AlphaMode::Straight),
-            b"BC5S" => blocks(BlockFormat::Bc5 { signed: true }, AlphaMode::Straight),
-            _ => match code {
-                36 => plain(Format::new(4, U16, lin), 8),
-                111 => plain(Format::new(1, F16, lin), 2),
-                112 => plain(Format::new(2, F16, lin).with_alpha(AlphaMode::None), 4),
-                113 => plain(Format::new(4, F16, lin), 8),
-                114 => plain(Format::new(1, F32, lin), 4),
-                115 => plain(Format::new(2, F32, lin).with_alpha(AlphaMode::None), 8),
-                116 => plain(Format::new(4, F32, lin), 16),
-                _ => {
-                    return Err(decode_err(format!(
-                        "fourCC {} is not a format parvo reads (it reads DXT1-DXT5, ATI1/ATI2, \
-                         BC4U/BC4S/BC5U/BC5S, DX10 and the D3DX codes 36 and 111-116)",
-                        fourcc_text(code)
-                    )));
-                }
-            },
-        };
-        return Ok((st, format!("fourCC {}", fourcc_text(code))));
+        return stored_of_fourcc(pf.fourcc);
     }
     if pf.flags & (ddpf::YUV | ddpf::BUMPDUDV) != 0 {
         return Err(decode_err(
             "YUV and signed bump-map (DUDV) pixel formats are not supported",
         ));
     }
+    stored_of_masks(pf)
+}
+
+/// What a DX10 header's DXGI format and alpha mode say is stored.
+fn stored_of_dx10(d: &Dx10) -> Result<(Stored, String)> {
+    let mode = d.misc_flags2 & 7;
+    if let Some(&(_, bf, srgb)) = DXGI_BLOCKS.iter().find(|e| e.0 == d.dxgi_format) {
+        let alpha = match mode {
+            alpha_mode::PREMULTIPLIED => AlphaMode::Premultiplied,
+            alpha_mode::OPAQUE => AlphaMode::None,
+            _ => AlphaMode::Straight,
+        };
+        return Ok((
+            Stored::Blocks {
+                format: bf,
+                srgb,
+                alpha,
+            },
+            format!(
+                "DX10 {}",
+                dxgi_name(d.dxgi_format).unwrap_or(if srgb { "sRGB" } else { "" })
+            ),
+        ));
+    }
+    let &(_, ch, ty, srgb, swap, padded, name) = DXGI_PLAIN
+        .iter()
+        .find(|e| e.0 == d.dxgi_format)
+        .ok_or_else(|| {
+        decode_err(format!(
+            "DXGI format {} is not one parvo reads (it reads the uncompressed UNORM 8-bit \
+                 and 16-bit, half and float R/RG/RGB/RGBA/BGRA formats and BC1-BC7)",
+            dxgi_describe(d.dxgi_format)
+        ))
+    })?;
+    let cs = if srgb {
+        ColorSpace::Srgb
+    } else {
+        ColorSpace::Linear
+    };
+    let mut format = Format::new(ch, ty, cs);
+    let mut drop_alpha = padded;
+    match (ch, mode) {
+        (2, alpha_mode::STRAIGHT) => {}
+        (2, alpha_mode::PREMULTIPLIED) | (4, alpha_mode::PREMULTIPLIED) => {
+            format = format.with_alpha(AlphaMode::Premultiplied)
+        }
+        (2, _) => format = format.with_alpha(AlphaMode::None),
+        (4, alpha_mode::OPAQUE) => drop_alpha = true,
+        (4, alpha_mode::CUSTOM) => format = format.with_alpha(AlphaMode::None),
+        _ => {}
+    }
+    let bytes = ch as usize * ty.bytes();
+    if drop_alpha {
+        format.channels = 3;
+    }
+    Ok((
+        Stored::Plain {
+            format,
+            bytes,
+            masks: None,
+            swap_rb: swap,
+            drop_alpha,
+        },
+        format!("DX10 {name}"),
+    ))
+}
+
+/// Refuse a palettised pixel format ([`PALETTE_FLAGS`]).
+fn refuse_palette(pf: &PixelFormat) -> Result<()> {
+    let Some((_, bits)) = PALETTE_FLAGS.iter().find(|(flag, _)| pf.flags & flag != 0) else {
+        return Ok(());
+    };
+    Err(decode_err(format!(
+        "this is a palettised DDS ({}palette indices, pixel format flags {:#x}), which parvo \
+         does not read",
+        if bits.is_empty() {
+            String::new()
+        } else {
+            format!("{bits} ")
+        },
+        pf.flags
+    )))
+}
+
+/// What a fourCC says is stored ([`FOURCC_BLOCKS`], [`FOURCC_PLAIN`]).
+fn stored_of_fourcc(code: u32) -> Result<(Stored, String)> {
+    if code == 0 {
+        return Err(decode_err(
+            "the pixel format says a fourCC names the format, but the fourCC is empty (0)",
+        ));
+    }
+    let blocks = FOURCC_BLOCKS
+        .iter()
+        .find(|e| e.0 == &code.to_le_bytes())
+        .map(|&(_, format, alpha)| Stored::Blocks {
+            format,
+            srgb: false,
+            alpha,
+        });
+    let plain = || {
+        FOURCC_PLAIN
+            .iter()
+            .find(|e| e.0 == code)
+            .map(|&(_, ch, ty)| {
+                let mut format = Format::new(ch, ty, ColorSpace::Linear);
+                if ch == 2 {
+                    format = format.with_alpha(AlphaMode::None);
+                }
+                Stored::Plain {
+                    format,
+                    bytes: ch as usize * ty.bytes(),
+                    masks: None,
+                    swap_rb: false,
+                    drop_alpha: false,
+                }
+            })
+    };
+    let st = blocks.or_else(plain).ok_or_else(|| {
+        decode_err(format!(
+            "fourCC {} is not a format parvo reads (it reads DXT1-DXT5, ATI1/ATI2, \
+             BC4U/BC4S/BC5U/BC5S, DX10 and the D3DX codes 36 and 111-116)",
+            fourcc_text(code)
+        ))
+    })?;
+    Ok((st, format!("fourCC {}", fourcc_text(code))))
+}
+
+/// What a legacy pixel format's bit count, masks and RGB / LUMINANCE /
+/// ALPHA flags say is stored.
+fn stored_of_masks(pf: &PixelFormat) -> Result<(Stored, String)> {
+    let lin = ColorSpace::Linear;
     let bits = pf.rgb_bit_count;
     if !matches!(bits, 8 | 16 | 24 | 32) {
         return Err(decode_err(format!(
@@ -1030,7 +1087,13 @@ fn stored_of(h: &Header) -> Result<(Stored, String)> {
         if bits == 32 && r == 0xffff_ffff && g == 0 && b == 0 {
             // D3DX's alternative R32F (DirectXTex reads it as R32_FLOAT).
             return Ok((
-                plain(Format::new(1, F32, lin), 4),
+                Stored::Plain {
+                    format: Format::new(1, ChannelType::F32, lin),
+                    bytes: 4,
+                    masks: None,
+                    swap_rb: false,
+                    drop_alpha: false,
+                },
                 "legacy R32F (RGB mask ffffffff)".into(),
             ));
         }
@@ -1061,7 +1124,11 @@ fn stored_of(h: &Header) -> Result<(Stored, String)> {
             pf.masks[0], pf.masks[1], pf.masks[2], pf.masks[3]
         )));
     }
-    let ty = if widest <= 8 { U8 } else { U16 };
+    let ty = if widest <= 8 {
+        ChannelType::U8
+    } else {
+        ChannelType::U16
+    };
     let mut format = Format::new(channels as u8, ty, lin);
     if channels == 2 && !has_a {
         format = format.with_alpha(AlphaMode::None);
@@ -1453,6 +1520,23 @@ mod tests {
         let b = h.to_bytes();
         assert_eq!(b.len(), HEADER_BYTES + DX10_BYTES);
         assert_eq!(Header::parse(&b).unwrap(), h);
+    }
+
+    #[test]
+    fn format_tables_agree_with_the_dxgi_names() {
+        // Each value once, ascending, so a lookup finds the only entry.
+        assert!(DXGI_NAMES.windows(2).all(|p| p[0].0 < p[1].0));
+        // The formats read carry the names Microsoft gives their values.
+        for e in DXGI_PLAIN {
+            assert_eq!(dxgi_name(e.0), Some(e.6), "{}", e.0);
+        }
+        for (v, bf, srgb) in DXGI_BLOCKS {
+            let name = dxgi_name(v).unwrap();
+            assert!(name.starts_with(&bf.to_string()[..3]), "{v} {name} {bf}");
+            assert_eq!(name.ends_with("_SRGB"), srgb, "{v} {name}");
+        }
+        assert_eq!(dxgi_name(116), None);
+        assert_eq!(dxgi_name(191), None);
     }
 
     #[test]

@@ -875,6 +875,10 @@ fn choose_channels(
     Ok((order, alpha, note))
 }
 
+/// The pixels of one part as the `exr` crate reads them: every resolution
+/// level of every channel.
+type Part = ::exr::image::Layer<::exr::image::AnyChannels<::exr::image::Levels<FlatSamples>>>;
+
 /// Load an EXR file: the first part (or `options.subimage`), all its mip
 /// levels, the channels chosen as the module docs say; a data window that is
 /// not the display window is placed in the display window, black outside
@@ -905,27 +909,12 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
             Setting::Subimage
         ));
     }
-    let (w, h) = (header.layer_size.width(), header.layer_size.height());
-    let (sizes, tile, rounding, mipmapped) = match header.blocks {
-        BlockDescription::ScanLines => (vec![(w, h)], None, Rounding::Down, false),
-        BlockDescription::Tiles(t) => {
-            let rounding = match t.rounding_mode {
-                RoundingMode::Down => Rounding::Down,
-                RoundingMode::Up => Rounding::Up,
-            };
-            let tile = Some((t.tile_size.width() as u32, t.tile_size.height() as u32));
-            match t.level_mode {
-                LevelMode::MipMap => {
-                    let s: Vec<_> = ::exr::meta::mip_map_levels(t.rounding_mode, header.layer_size)
-                        .map(|(_, s)| (s.width(), s.height()))
-                        .collect();
-                    (s, tile, rounding, true)
-                }
-                // Rip maps: only level 0 (anisotropic levels are not a mip chain).
-                _ => (vec![(w, h)], tile, rounding, false),
-            }
-        }
-    };
+    let Declared {
+        sizes,
+        tile,
+        rounding,
+        mipmapped,
+    } = declared_levels(header);
     let all_names: Vec<String> = header
         .channels
         .list
@@ -934,117 +923,13 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         .collect();
     let (order, alpha, note) = choose_channels(&all_names, options.channels.as_deref())?;
     notes.extend(note);
-    let channels = header.channels.list.len() as u64;
-    let texels: u64 = sizes.iter().map(|&(a, b)| a as u64 * b as u64).sum();
-    // Decoded bytes: the exr crate's planes (of every part when another
-    // than the first is read) plus our interleaved copy.
-    let planes: u64 = if part == 0 {
-        texels.saturating_mul(channels).saturating_mul(4)
-    } else {
-        meta.headers
-            .iter()
-            .map(|h| {
-                (h.layer_size.area() as u64)
-                    .saturating_mul(h.channels.list.len() as u64)
-                    .saturating_mul(8)
-            })
-            .sum()
-    };
-    limits.check(
-        w as u64,
-        h as u64,
-        planes.saturating_add(texels.saturating_mul(order.len() as u64 * 4)),
-    )?;
-    let mut attributes: Vec<(String, String)> = Vec::new();
-    for (k, v) in header
-        .shared_attributes
-        .other
-        .iter()
-        .chain(header.own_attributes.other.iter())
-    {
-        attributes.push((k.to_string(), attribute_text(v)));
-    }
-    let own = &header.own_attributes;
-    for (k, v) in [
-        ("software", &own.software_name),
-        ("comments", &own.comments),
-        ("owner", &own.owner),
-        ("capDate", &own.capture_date),
-        ("name", &own.layer_name),
-        ("wrapmodes", &own.wrap_mode_name),
-    ] {
-        if let Some(t) = v {
-            attributes.push((k.to_string(), t.to_string()));
-        }
-    }
-    attributes.push(("compression".into(), header.compression.to_string()));
-    // An environment map, by OpenEXR's `envmap` attribute or the
-    // `textureformat` maketx writes.
-    let texture_format = attributes
-        .iter()
-        .find(|(k, _)| k == "textureformat")
-        .map(|(_, v)| v.clone());
-    let environment = match (own.environment_map, texture_format.as_deref()) {
-        (Some(::exr::meta::attribute::EnvironmentMap::Cube), _)
-        | (None, Some("CubeFace Environment")) => Some(super::Environment::Cube),
-        (Some(::exr::meta::attribute::EnvironmentMap::LatitudeLongitude), _)
-        | (None, Some("LatLong Environment")) => Some(super::Environment::LatLong),
-        _ => None,
-    };
-    if let Some(kind) = environment {
-        let mut detail = Vec::new();
-        if let Some(t) = &texture_format {
-            detail.push(format!("textureformat \"{t}\""));
-        }
-        if let Some(e) = own.environment_map {
-            detail.push(format!(
-                "envmap {}",
-                match e {
-                    ::exr::meta::attribute::EnvironmentMap::LatitudeLongitude => "latlong",
-                    ::exr::meta::attribute::EnvironmentMap::Cube => "cube",
-                }
-            ));
-        }
-        detail.push(if kind == super::Environment::Cube && h == 6 * w {
-            format!("six {w}x{w} faces stacked top to bottom")
-        } else {
-            format!("{w}x{h}")
-        });
-        super::environment_map("OpenEXR", kind, &detail.join(", "), options, &mut notes)?;
-    }
+    check_decoded_size(&meta, part, &sizes, order.len(), limits)?;
+    let mut attributes = header_attributes(header);
+    let environment = environment_of(header, &attributes, options, &mut notes)?;
     let data_window = header.data_window();
     let display = header.shared_attributes.display_window;
     if data_window != display {
-        // Level 0 is placed in the display window: its size is what is
-        // allocated, so it is held to the limits too (an 8x8 data window
-        // in an 83886074x8 display window asked for 18 GB:
-        // tests/regression/exr_display_window_unbounded.rs).
-        let (dw, dh) = (display.size.width() as u64, display.size.height() as u64);
-        limits.check(
-            dw,
-            dh,
-            dw.saturating_mul(dh).saturating_mul(order.len() as u64 * 4),
-        )?;
-        attributes.push((
-            "dataWindow".into(),
-            format!(
-                "({}, {}) {}x{}",
-                data_window.position.x(),
-                data_window.position.y(),
-                data_window.size.width(),
-                data_window.size.height()
-            ),
-        ));
-        attributes.push((
-            "displayWindow".into(),
-            format!(
-                "({}, {}) {}x{}",
-                display.position.x(),
-                display.position.y(),
-                display.size.width(),
-                display.size.height()
-            ),
-        ));
+        check_display_window(data_window, display, order.len(), limits, &mut attributes)?;
     }
     attributes.sort();
     let wrap = super::recorded_wrap(
@@ -1055,29 +940,7 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         &mut notes,
     );
 
-    let reader = ::exr::prelude::read()
-        .no_deep_data()
-        .all_resolution_levels()
-        .all_channels();
-    let layer = if part == 0 {
-        reader
-            .first_valid_layer()
-            .all_attributes()
-            .from_file(path)
-            .map_err(decode_err)?
-            .layer_data
-    } else {
-        let mut layers = reader
-            .all_layers()
-            .all_attributes()
-            .from_file(path)
-            .map_err(decode_err)?
-            .layer_data;
-        if part >= layers.len() {
-            return Err(decode_err(format!("part {part} has no readable pixels")));
-        }
-        layers.swap_remove(part)
-    };
+    let layer = read_part(path, part)?;
     let list = &layer.channel_data.list;
     // The crate's channel list is sorted by name, as the header's is.
     let by_name = |n: &str| list.iter().position(|c| c.name.to_string() == n);
@@ -1085,74 +948,7 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         .iter()
         .map(|&i| by_name(&all_names[i]).ok_or_else(|| decode_err("channel list changed")))
         .collect::<Result<_>>()?;
-    let half = order.iter().all(|&i| {
-        matches!(
-            list[i].sample_data.levels_as_slice()[0],
-            FlatSamples::F16(_)
-        )
-    });
-    let per_channel: Vec<Vec<&FlatSamples>> = order
-        .iter()
-        .map(|&i| match &list[i].sample_data {
-            ::exr::image::Levels::Singular(s) => vec![s],
-            ::exr::image::Levels::Mip { level_data, .. } => level_data.iter().collect(),
-            ::exr::image::Levels::Rip { level_data, .. } => {
-                level_data.map_data.iter().take(1).collect()
-            }
-        })
-        .collect();
-    let nlev = per_channel[0].len();
-    if nlev == 0
-        || per_channel.iter().any(|c| c.len() != nlev)
-        || (mipmapped && nlev != sizes.len())
-    {
-        return Err(decode_err("inconsistent mip levels between channels"));
-    }
-    let ch = order.len();
-    let ty = if half {
-        ChannelType::F16
-    } else {
-        ChannelType::F32
-    };
-    // OpenEXR stores colour associated with (premultiplied by) alpha.
-    let mut format = Format::new(ch as u8, ty, ColorSpace::Linear);
-    format = format.with_alpha(if alpha {
-        AlphaMode::Premultiplied
-    } else {
-        AlphaMode::None
-    });
-    let mut levels = Vec::with_capacity(nlev);
-    for (k, &(lw, lh)) in sizes.iter().enumerate().take(nlev) {
-        let n = lw * lh;
-        let texels = if half {
-            let mut out = vec![f16::ZERO; n * ch];
-            for (c, planes) in per_channel.iter().enumerate() {
-                let FlatSamples::F16(p) = planes[k] else {
-                    return Err(decode_err("channel type changed between levels"));
-                };
-                if p.len() != n {
-                    return Err(decode_err("level has the wrong number of samples"));
-                }
-                for (o, v) in out.iter_mut().skip(c).step_by(ch).zip(p.iter()) {
-                    *o = *v;
-                }
-            }
-            Texels::F16(out)
-        } else {
-            let mut out = vec![0f32; n * ch];
-            for (c, planes) in per_channel.iter().enumerate() {
-                let p = planes[k];
-                if p.len() != n {
-                    return Err(decode_err("level has the wrong number of samples"));
-                }
-                for (o, v) in out.iter_mut().skip(c).step_by(ch).zip(p.values_as_f32()) {
-                    *o = v;
-                }
-            }
-            Texels::F32(out)
-        };
-        levels.push(Texture::from_texels(lw as u32, lh as u32, format, texels)?);
-    }
+    let mut levels = read_levels(list, &order, &sizes, mipmapped, alpha)?;
     if data_window != display {
         let (placed, note) = place_in_display_window(&levels[0], data_window, display)?;
         if levels.len() > 1 {
@@ -1180,6 +976,309 @@ pub fn load(path: &Path, limits: &Limits, options: &super::LoadOptions) -> Resul
         environment,
     };
     Ok(Loaded { levels, info })
+}
+
+/// The levels a header declares.
+struct Declared {
+    /// Level sizes: all of a mip map; level 0 of scan lines and of a rip
+    /// map, whose anisotropic levels are not a mip chain.
+    sizes: Vec<(usize, usize)>,
+    /// The tile size of a tiled file.
+    tile: Option<(u32, u32)>,
+    rounding: Rounding,
+    /// A mip map: every level in `sizes` must be in the file.
+    mipmapped: bool,
+}
+
+/// The levels `header` declares.
+fn declared_levels(header: &Header) -> Declared {
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    let BlockDescription::Tiles(t) = header.blocks else {
+        return Declared {
+            sizes: vec![(w, h)],
+            tile: None,
+            rounding: Rounding::Down,
+            mipmapped: false,
+        };
+    };
+    let rounding = match t.rounding_mode {
+        RoundingMode::Down => Rounding::Down,
+        RoundingMode::Up => Rounding::Up,
+    };
+    let tile = Some((t.tile_size.width() as u32, t.tile_size.height() as u32));
+    let mipmapped = t.level_mode == LevelMode::MipMap;
+    let sizes = if mipmapped {
+        ::exr::meta::mip_map_levels(t.rounding_mode, header.layer_size)
+            .map(|(_, s)| (s.width(), s.height()))
+            .collect()
+    } else {
+        // Rip maps: only level 0 (anisotropic levels are not a mip chain).
+        vec![(w, h)]
+    };
+    Declared {
+        sizes,
+        tile,
+        rounding,
+        mipmapped,
+    }
+}
+
+/// Hold what decoding part `part` allocates to `limits`, from the headers
+/// alone: the `exr` crate's planes of the declared levels (of every part
+/// when another than the first is read) plus our interleaved copy of
+/// `kept` channels.
+fn check_decoded_size(
+    meta: &MetaData,
+    part: usize,
+    sizes: &[(usize, usize)],
+    kept: usize,
+    limits: &Limits,
+) -> Result<()> {
+    let header = &meta.headers[part];
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    let channels = header.channels.list.len() as u64;
+    let texels: u64 = sizes.iter().map(|&(a, b)| a as u64 * b as u64).sum();
+    let planes: u64 = if part == 0 {
+        texels.saturating_mul(channels).saturating_mul(4)
+    } else {
+        meta.headers
+            .iter()
+            .map(|h| {
+                (h.layer_size.area() as u64)
+                    .saturating_mul(h.channels.list.len() as u64)
+                    .saturating_mul(8)
+            })
+            .sum()
+    };
+    limits.check(
+        w as u64,
+        h as u64,
+        planes.saturating_add(texels.saturating_mul(kept as u64 * 4)),
+    )
+}
+
+/// The header's attributes as text for `parvo info`: the other (custom)
+/// ones, the standard ones that are set, and the compression; unsorted.
+fn header_attributes(header: &Header) -> Vec<(String, String)> {
+    let mut attributes: Vec<(String, String)> = Vec::new();
+    for (k, v) in header
+        .shared_attributes
+        .other
+        .iter()
+        .chain(header.own_attributes.other.iter())
+    {
+        attributes.push((k.to_string(), attribute_text(v)));
+    }
+    let own = &header.own_attributes;
+    for (k, v) in [
+        ("software", &own.software_name),
+        ("comments", &own.comments),
+        ("owner", &own.owner),
+        ("capDate", &own.capture_date),
+        ("name", &own.layer_name),
+        ("wrapmodes", &own.wrap_mode_name),
+    ] {
+        if let Some(t) = v {
+            attributes.push((k.to_string(), t.to_string()));
+        }
+    }
+    attributes.push(("compression".into(), header.compression.to_string()));
+    attributes
+}
+
+/// An environment map, by OpenEXR's `envmap` attribute or the
+/// `textureformat` maketx writes: refused, or described in `notes`, as
+/// [`super::environment_map`] decides.
+fn environment_of(
+    header: &Header,
+    attributes: &[(String, String)],
+    options: &super::LoadOptions,
+    notes: &mut Vec<String>,
+) -> Result<Option<super::Environment>> {
+    use ::exr::meta::attribute::EnvironmentMap;
+    let own = &header.own_attributes;
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    let texture_format = attributes
+        .iter()
+        .find(|(k, _)| k == "textureformat")
+        .map(|(_, v)| v.clone());
+    let environment = match (own.environment_map, texture_format.as_deref()) {
+        (Some(EnvironmentMap::Cube), _) | (None, Some("CubeFace Environment")) => {
+            Some(super::Environment::Cube)
+        }
+        (Some(EnvironmentMap::LatitudeLongitude), _) | (None, Some("LatLong Environment")) => {
+            Some(super::Environment::LatLong)
+        }
+        _ => None,
+    };
+    if let Some(kind) = environment {
+        let mut detail = Vec::new();
+        if let Some(t) = &texture_format {
+            detail.push(format!("textureformat \"{t}\""));
+        }
+        if let Some(e) = own.environment_map {
+            detail.push(format!(
+                "envmap {}",
+                match e {
+                    EnvironmentMap::LatitudeLongitude => "latlong",
+                    EnvironmentMap::Cube => "cube",
+                }
+            ));
+        }
+        detail.push(if kind == super::Environment::Cube && h == 6 * w {
+            format!("six {w}x{w} faces stacked top to bottom")
+        } else {
+            format!("{w}x{h}")
+        });
+        super::environment_map("OpenEXR", kind, &detail.join(", "), options, notes)?;
+    }
+    Ok(environment)
+}
+
+/// A data window that is not the display window: level 0 is placed in the
+/// display window, so its size is what is allocated and is held to the
+/// limits too (an 8x8 data window in an 83886074x8 display window asked
+/// for 18 GB: tests/regression/exr_display_window_unbounded.rs); both
+/// windows go into `attributes`.
+fn check_display_window(
+    data_window: ::exr::meta::attribute::IntegerBounds,
+    display: ::exr::meta::attribute::IntegerBounds,
+    kept: usize,
+    limits: &Limits,
+    attributes: &mut Vec<(String, String)>,
+) -> Result<()> {
+    let (dw, dh) = (display.size.width() as u64, display.size.height() as u64);
+    limits.check(
+        dw,
+        dh,
+        dw.saturating_mul(dh).saturating_mul(kept as u64 * 4),
+    )?;
+    for (name, window) in [("dataWindow", data_window), ("displayWindow", display)] {
+        attributes.push((
+            name.into(),
+            format!(
+                "({}, {}) {}x{}",
+                window.position.x(),
+                window.position.y(),
+                window.size.width(),
+                window.size.height()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Read the pixels of part `part`, every level of every channel.
+fn read_part(path: &Path, part: usize) -> Result<Part> {
+    let reader = ::exr::prelude::read()
+        .no_deep_data()
+        .all_resolution_levels()
+        .all_channels();
+    if part == 0 {
+        return Ok(reader
+            .first_valid_layer()
+            .all_attributes()
+            .from_file(path)
+            .map_err(decode_err)?
+            .layer_data);
+    }
+    let mut layers = reader
+        .all_layers()
+        .all_attributes()
+        .from_file(path)
+        .map_err(decode_err)?
+        .layer_data;
+    if part >= layers.len() {
+        return Err(decode_err(format!("part {part} has no readable pixels")));
+    }
+    Ok(layers.swap_remove(part))
+}
+
+/// The levels of channels `order` of `list` (indices into it),
+/// interleaved: f16 when every chosen channel is half, else f32; linear,
+/// with premultiplied alpha when `alpha`. `sizes` are the declared level
+/// sizes, all of which a mip map (`mipmapped`) must hold.
+fn read_levels(
+    list: &[::exr::image::AnyChannel<::exr::image::Levels<FlatSamples>>],
+    order: &[usize],
+    sizes: &[(usize, usize)],
+    mipmapped: bool,
+    alpha: bool,
+) -> Result<Vec<Texture>> {
+    let half = order.iter().all(|&i| {
+        matches!(
+            list[i].sample_data.levels_as_slice()[0],
+            FlatSamples::F16(_)
+        )
+    });
+    let per_channel: Vec<Vec<&FlatSamples>> = order
+        .iter()
+        .map(|&i| match &list[i].sample_data {
+            ::exr::image::Levels::Singular(s) => vec![s],
+            ::exr::image::Levels::Mip { level_data, .. } => level_data.iter().collect(),
+            ::exr::image::Levels::Rip { level_data, .. } => {
+                level_data.map_data.iter().take(1).collect()
+            }
+        })
+        .collect();
+    let nlev = per_channel[0].len();
+    if nlev == 0
+        || per_channel.iter().any(|c| c.len() != nlev)
+        || (mipmapped && nlev != sizes.len())
+    {
+        return Err(decode_err("inconsistent mip levels between channels"));
+    }
+    let ty = if half {
+        ChannelType::F16
+    } else {
+        ChannelType::F32
+    };
+    // OpenEXR stores colour associated with (premultiplied by) alpha.
+    let mut format = Format::new(order.len() as u8, ty, ColorSpace::Linear);
+    format = format.with_alpha(if alpha {
+        AlphaMode::Premultiplied
+    } else {
+        AlphaMode::None
+    });
+    let mut levels = Vec::with_capacity(nlev);
+    for (k, &(lw, lh)) in sizes.iter().enumerate().take(nlev) {
+        let planes: Vec<&FlatSamples> = per_channel.iter().map(|c| c[k]).collect();
+        let texels = interleave(&planes, lw * lh, half)?;
+        levels.push(Texture::from_texels(lw as u32, lh as u32, format, texels)?);
+    }
+    Ok(levels)
+}
+
+/// One level's channel planes of `n` samples each, interleaved (f16 when
+/// `half`, else every plane converted to f32).
+fn interleave(planes: &[&FlatSamples], n: usize, half: bool) -> Result<Texels> {
+    let ch = planes.len();
+    if half {
+        let mut out = vec![f16::ZERO; n * ch];
+        for (c, plane) in planes.iter().enumerate() {
+            let FlatSamples::F16(p) = plane else {
+                return Err(decode_err("channel type changed between levels"));
+            };
+            if p.len() != n {
+                return Err(decode_err("level has the wrong number of samples"));
+            }
+            for (o, v) in out.iter_mut().skip(c).step_by(ch).zip(p.iter()) {
+                *o = *v;
+            }
+        }
+        Ok(Texels::F16(out))
+    } else {
+        let mut out = vec![0f32; n * ch];
+        for (c, p) in planes.iter().enumerate() {
+            if p.len() != n {
+                return Err(decode_err("level has the wrong number of samples"));
+            }
+            for (o, v) in out.iter_mut().skip(c).step_by(ch).zip(p.values_as_f32()) {
+                *o = v;
+            }
+        }
+        Ok(Texels::F32(out))
+    }
 }
 
 /// Level 0 placed in the display window: texels of the data window inside

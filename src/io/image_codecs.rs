@@ -227,7 +227,7 @@ fn load_image(
     options: &LoadOptions,
     overlap: Option<Overlap<'_>>,
 ) -> Result<Loaded> {
-    use image::{DynamicImage, ImageDecoder, ImageFormat};
+    use image::ImageDecoder;
     let io_err = |action: &str, e| Error::Io {
         path: path.to_path_buf(),
         action: action.into(),
@@ -238,9 +238,9 @@ fn load_image(
         .with_guessed_format()
         .map_err(|e| io_err("cannot read", e))?;
     let file_format = match reader.format() {
-        Some(ImageFormat::Png) => FileFormat::Png,
-        Some(ImageFormat::Jpeg) => FileFormat::Jpeg,
-        Some(ImageFormat::Hdr) => FileFormat::Hdr,
+        Some(image::ImageFormat::Png) => FileFormat::Png,
+        Some(image::ImageFormat::Jpeg) => FileFormat::Jpeg,
+        Some(image::ImageFormat::Hdr) => FileFormat::Hdr,
         _ => {
             return Err(Error::Decode {
                 format: "input",
@@ -295,99 +295,13 @@ fn load_image(
     }
     let (w, h) = decoder.dimensions();
     limits.check(w as u64, h as u64, decoder.total_bytes())?;
-    let ct = decoder.color_type();
-    let overlap = overlap.map(|f| {
-        let ch = ct.channel_count();
-        let ty = match ct.bytes_per_pixel() / ch {
-            1 => ChannelType::U8,
-            2 => ChannelType::U16,
-            _ => ChannelType::F32,
-        };
-        move || f(w, h, ch, ty)
-    });
-    let mut img = match ct {
-        // 8-bit images (the common large case) are decoded into a buffer
-        // whose pages another thread maps meanwhile (`mem::populate`):
-        // the decoder runs on one core, and first touches of a 16384²
-        // RGBA8 image cost it seconds. `overlap` follows on that thread.
-        image::ColorType::L8
-        | image::ColorType::La8
-        | image::ColorType::Rgb8
-        | image::ColorType::Rgba8 => {
-            let mut buf: Vec<u8> = crate::mem::zeroed(
-                usize::try_from(decoder.total_bytes())
-                    .map_err(|_| Error::Limits("image larger than memory".into()))?,
-            );
-            let (ptr, len) = (buf.as_ptr() as usize, buf.len());
-            let populate = len >= 64 << 20;
-            std::thread::scope(|s| {
-                if populate || overlap.is_some() {
-                    s.spawn(move || {
-                        if populate {
-                            crate::mem::populate(ptr as *const u8, len);
-                        }
-                        if let Some(mut f) = overlap {
-                            f();
-                        }
-                    });
-                }
-                decoder.read_image(&mut buf)
-            })
-            .map_err(lim)?;
-            let bad = || Error::Decode {
-                format: file_format.name(),
-                reason: "the decoded image does not match its declared size".into(),
-            };
-            match ct {
-                image::ColorType::L8 => DynamicImage::ImageLuma8(
-                    image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
-                ),
-                image::ColorType::La8 => DynamicImage::ImageLumaA8(
-                    image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
-                ),
-                image::ColorType::Rgb8 => DynamicImage::ImageRgb8(
-                    image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
-                ),
-                _ => DynamicImage::ImageRgba8(
-                    image::ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?,
-                ),
-            }
-        }
-        _ => std::thread::scope(|s| {
-            if let Some(f) = overlap {
-                s.spawn(f);
-            }
-            DynamicImage::from_decoder(decoder)
-        })
-        .map_err(lim)?,
-    };
-    if let (Some(t), DynamicImage::ImageLumaA8(b)) = (extras.grey_trns, &mut img) {
+    let mut img = decode(decoder, file_format, overlap, lim)?;
+    if let (Some(t), image::DynamicImage::ImageLumaA8(b)) = (extras.grey_trns, &mut img) {
         for px in b.chunks_exact_mut(2) {
             px[1] = if px[0] == t { 0 } else { u8::MAX };
         }
     }
-    let (w, h) = (img.width(), img.height());
-    let f = |ch: u8, ty: ChannelType| {
-        let cs = match (file_format, png_cs) {
-            (FileFormat::Png, Some(cs)) if !ty.is_float() => cs,
-            (FileFormat::Jpeg, _) if ty == ChannelType::U8 => ColorSpace::Srgb,
-            _ => ColorSpace::Linear,
-        };
-        Format::new(ch, ty, cs)
-    };
-    use ChannelType::*;
-    let mut tex = match img {
-        DynamicImage::ImageLuma8(b) => Texture::from_u8(w, h, f(1, U8), b.into_raw()),
-        DynamicImage::ImageLumaA8(b) => Texture::from_u8(w, h, f(2, U8), b.into_raw()),
-        DynamicImage::ImageRgb8(b) => Texture::from_u8(w, h, f(3, U8), b.into_raw()),
-        DynamicImage::ImageRgba8(b) => Texture::from_u8(w, h, f(4, U8), b.into_raw()),
-        DynamicImage::ImageLuma16(b) => Texture::from_u16(w, h, f(1, U16), b.into_raw()),
-        DynamicImage::ImageLumaA16(b) => Texture::from_u16(w, h, f(2, U16), b.into_raw()),
-        DynamicImage::ImageRgb16(b) => Texture::from_u16(w, h, f(3, U16), b.into_raw()),
-        DynamicImage::ImageRgba16(b) => Texture::from_u16(w, h, f(4, U16), b.into_raw()),
-        DynamicImage::ImageRgb32F(b) => Texture::from_f32(w, h, f(3, F32), b.into_raw()),
-        other => Texture::from_f32(w, h, f(4, F32), other.into_rgba32f().into_raw()),
-    }?;
+    let mut tex = texture_of(img, file_format, png_cs)?;
     let mut attributes = Vec::new();
     if orientation != 1 {
         attributes.push(("Orientation".to_string(), orientation.to_string()));
@@ -412,4 +326,109 @@ fn load_image(
         levels: vec![tex],
         info,
     })
+}
+
+/// Decode the whole image, running `overlap` on another thread meanwhile.
+/// 8-bit images (the common large case) are decoded into a buffer whose
+/// pages that thread maps first (`mem::populate`): the decoder runs on
+/// one core, and first touches of a 16384² RGBA8 image cost it seconds.
+fn decode<D: image::ImageDecoder>(
+    decoder: D,
+    file_format: FileFormat,
+    overlap: Option<Overlap<'_>>,
+    lim: impl Fn(image::ImageError) -> Error,
+) -> Result<image::DynamicImage> {
+    use image::{ColorType, DynamicImage, ImageBuffer};
+    let (w, h) = decoder.dimensions();
+    let ct = decoder.color_type();
+    let overlap = overlap.map(|f| {
+        let ch = ct.channel_count();
+        let ty = match ct.bytes_per_pixel() / ch {
+            1 => ChannelType::U8,
+            2 => ChannelType::U16,
+            _ => ChannelType::F32,
+        };
+        move || f(w, h, ch, ty)
+    });
+    if !matches!(
+        ct,
+        ColorType::L8 | ColorType::La8 | ColorType::Rgb8 | ColorType::Rgba8
+    ) {
+        return std::thread::scope(|s| {
+            if let Some(f) = overlap {
+                s.spawn(f);
+            }
+            DynamicImage::from_decoder(decoder)
+        })
+        .map_err(lim);
+    }
+    let mut buf: Vec<u8> = crate::mem::zeroed(
+        usize::try_from(decoder.total_bytes())
+            .map_err(|_| Error::Limits("image larger than memory".into()))?,
+    );
+    let (ptr, len) = (buf.as_ptr() as usize, buf.len());
+    let populate = len >= 64 << 20;
+    std::thread::scope(|s| {
+        if populate || overlap.is_some() {
+            s.spawn(move || {
+                if populate {
+                    crate::mem::populate(ptr as *const u8, len);
+                }
+                if let Some(mut f) = overlap {
+                    f();
+                }
+            });
+        }
+        decoder.read_image(&mut buf)
+    })
+    .map_err(lim)?;
+    let bad = || Error::Decode {
+        format: file_format.name(),
+        reason: "the decoded image does not match its declared size".into(),
+    };
+    Ok(match ct {
+        ColorType::L8 => {
+            DynamicImage::ImageLuma8(ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?)
+        }
+        ColorType::La8 => {
+            DynamicImage::ImageLumaA8(ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?)
+        }
+        ColorType::Rgb8 => {
+            DynamicImage::ImageRgb8(ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?)
+        }
+        _ => DynamicImage::ImageRgba8(ImageBuffer::from_raw(w, h, buf).ok_or_else(bad)?),
+    })
+}
+
+/// The decoded image as a texture: 8- and 16-bit integer images as they
+/// are, in the colour space the PNG's chunks declare (`png_cs`), sRGB for
+/// JPEG, linear otherwise; float images as f32 RGB or RGBA, linear.
+fn texture_of(
+    img: image::DynamicImage,
+    file_format: FileFormat,
+    png_cs: Option<ColorSpace>,
+) -> Result<Texture> {
+    use ChannelType::*;
+    use image::DynamicImage;
+    let (w, h) = (img.width(), img.height());
+    let f = |ch: u8, ty: ChannelType| {
+        let cs = match (file_format, png_cs) {
+            (FileFormat::Png, Some(cs)) if !ty.is_float() => cs,
+            (FileFormat::Jpeg, _) if ty == ChannelType::U8 => ColorSpace::Srgb,
+            _ => ColorSpace::Linear,
+        };
+        Format::new(ch, ty, cs)
+    };
+    match img {
+        DynamicImage::ImageLuma8(b) => Texture::from_u8(w, h, f(1, U8), b.into_raw()),
+        DynamicImage::ImageLumaA8(b) => Texture::from_u8(w, h, f(2, U8), b.into_raw()),
+        DynamicImage::ImageRgb8(b) => Texture::from_u8(w, h, f(3, U8), b.into_raw()),
+        DynamicImage::ImageRgba8(b) => Texture::from_u8(w, h, f(4, U8), b.into_raw()),
+        DynamicImage::ImageLuma16(b) => Texture::from_u16(w, h, f(1, U16), b.into_raw()),
+        DynamicImage::ImageLumaA16(b) => Texture::from_u16(w, h, f(2, U16), b.into_raw()),
+        DynamicImage::ImageRgb16(b) => Texture::from_u16(w, h, f(3, U16), b.into_raw()),
+        DynamicImage::ImageRgba16(b) => Texture::from_u16(w, h, f(4, U16), b.into_raw()),
+        DynamicImage::ImageRgb32F(b) => Texture::from_f32(w, h, f(3, F32), b.into_raw()),
+        other => Texture::from_f32(w, h, f(4, F32), other.into_rgba32f().into_raw()),
+    }
 }

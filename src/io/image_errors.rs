@@ -134,8 +134,28 @@ pub(super) fn png_error(limits: &Limits, e: &png::DecodingError) -> Error {
 /// The `png` crate's format-error text (its error kinds are private) in
 /// words.
 fn png_format(text: &str) -> String {
-    let corrupt = |s: String| format!("{s}: the file is corrupt");
     let t = text.trim_end_matches('.');
+    chunk_fault(t)
+        .or_else(|| data_fault(t))
+        .or_else(|| header_fault(t))
+        .or_else(|| palette_fault(t))
+        .unwrap_or_else(|| {
+            if t.contains("tEXt") || t.contains("iTXt") || t.contains("compressed text") {
+                corrupt(format!("a text chunk is invalid ({})", lower_first(t)))
+            } else {
+                corrupt(lower_first(&printable(&strip_debug(t))))
+            }
+        })
+}
+
+/// `what`, said to make the file corrupt.
+fn corrupt(what: String) -> String {
+    format!("{what}: the file is corrupt")
+}
+
+/// A chunk that is damaged, misplaced, repeated or unknown (the `png`
+/// error names it in a `ChunkType { type: … }` debug structure).
+fn chunk_fault(t: &str) -> Option<String> {
     let chunks = chunk_names(t);
     let first = chunks.first().cloned().unwrap_or_else(|| "a".into());
     let chunk = |c: &str| {
@@ -145,81 +165,82 @@ fn png_format(text: &str) -> String {
             "bytes that are not a PNG chunk".to_string()
         }
     };
-    if t.starts_with("CRC error") {
-        return corrupt(format!(
+    let what = if t.starts_with("CRC error") {
+        format!(
             "the checksum (CRC) of {} does not match its data",
             chunk(&first)
-        ));
-    }
-    if t.ends_with("appeared before IHDR chunk") {
+        )
+    } else if t.ends_with("appeared before IHDR chunk") {
         let c = chunk(&first);
         let verb = if c.starts_with("the ") {
             "comes"
         } else {
             "come"
         };
-        return corrupt(format!("{c} {verb} before the IHDR header chunk"));
-    }
-    if t.ends_with("is invalid after IDAT chunk") {
-        return corrupt(format!(
+        format!("{c} {verb} before the IHDR header chunk")
+    } else if t.ends_with("is invalid after IDAT chunk") {
+        format!(
             "{} comes after the image data (IDAT), where PNG does not allow it",
             chunk(&first)
-        ));
-    }
-    if t.ends_with("is invalid before PLTE chunk") {
-        return corrupt(format!("{} comes before the palette (PLTE)", chunk(&first)));
-    }
-    if t.ends_with("is invalid after PLTE chunk") {
-        return corrupt(format!("{} comes after the palette (PLTE)", chunk(&first)));
-    }
-    if t.ends_with("must appear between PLTE and IDAT chunks") {
-        return corrupt(format!(
+        )
+    } else if t.ends_with("is invalid before PLTE chunk") {
+        format!("{} comes before the palette (PLTE)", chunk(&first))
+    } else if t.ends_with("is invalid after PLTE chunk") {
+        format!("{} comes after the palette (PLTE)", chunk(&first))
+    } else if t.ends_with("must appear between PLTE and IDAT chunks") {
+        format!(
             "{} is not between the palette (PLTE) and the image data (IDAT)",
             chunk(&first)
-        ));
-    }
-    if t.ends_with("must appear at most once") {
-        return corrupt(format!("{} appears more than once", chunk(&first)));
-    }
-    if t.starts_with("Chunk length wrong") {
-        return corrupt(format!("the length of {} is wrong", chunk(&first)));
-    }
-    if let Some(name) = t.strip_prefix("Unrecognized critical chunk: ") {
+        )
+    } else if t.ends_with("must appear at most once") {
+        format!("{} appears more than once", chunk(&first))
+    } else if t.starts_with("Chunk length wrong") {
+        format!("the length of {} is wrong", chunk(&first))
+    } else if let Some(name) = t.strip_prefix("Unrecognized critical chunk: ") {
         let name = name.trim_matches('"');
-        return corrupt(
-            if name.len() == 4 && name.chars().all(|c| c.is_ascii_alphabetic()) {
-                format!("it has an unknown critical chunk, {name}, which a reader must not skip")
-            } else {
-                "it has bytes where a chunk should be".into()
-            },
-        );
-    }
-    if t.starts_with("Unexpected restart of") {
-        return corrupt(format!("the run of {first} chunks is interrupted"));
-    }
-    if t.starts_with("Bad gamma value") {
-        return corrupt("its gAMA chunk holds an invalid gamma".into());
-    }
-    if t.contains("fcTL") || t.contains("fdAT") || t.contains("Sequence is not in order") {
-        return corrupt(format!(
+        if name.len() == 4 && name.chars().all(|c| c.is_ascii_alphabetic()) {
+            format!("it has an unknown critical chunk, {name}, which a reader must not skip")
+        } else {
+            "it has bytes where a chunk should be".into()
+        }
+    } else if t.starts_with("Unexpected restart of") {
+        format!("the run of {first} chunks is interrupted")
+    } else {
+        return None;
+    };
+    Some(corrupt(what))
+}
+
+/// A fault of the signature, the gamma, the animation chunks or the
+/// image data (missing, short, not inflating).
+fn data_fault(t: &str) -> Option<String> {
+    Some(if t.starts_with("Bad gamma value") {
+        corrupt("its gAMA chunk holds an invalid gamma".into())
+    } else if t.contains("fcTL") || t.contains("fdAT") || t.contains("Sequence is not in order") {
+        corrupt(format!(
             "its animation chunks are invalid ({})",
             lower_first(t)
-        ));
-    }
-    if t.starts_with("Invalid PNG signature") {
-        return "not a PNG file (its 8-byte signature is wrong)".into();
-    }
-    if t.starts_with("IDAT or fdAT chunk is missing") {
-        return "it has no image data (no IDAT chunk): the file is corrupt or truncated".into();
-    }
-    if t.starts_with("IDAT or fDAT chunk does not have enough data") {
-        return "its image data ends before the image does: the file is truncated".into();
-    }
-    if t.starts_with("Corrupt deflate stream") {
-        return "its compressed image data (IDAT) is corrupt or cut short".into();
-    }
+        ))
+    } else if t.starts_with("Invalid PNG signature") {
+        "not a PNG file (its 8-byte signature is wrong)".into()
+    } else if t.starts_with("IDAT or fdAT chunk is missing") {
+        "it has no image data (no IDAT chunk): the file is corrupt or truncated".into()
+    } else if t.starts_with("IDAT or fDAT chunk does not have enough data") {
+        "its image data ends before the image does: the file is truncated".into()
+    } else if t.starts_with("Corrupt deflate stream") {
+        "its compressed image data (IDAT) is corrupt or cut short".into()
+    } else {
+        return None;
+    })
+}
+
+/// A header (IHDR) value PNG does not allow: size, colour type, bit depth
+/// or their combination, compression, filter or interlace method.
+fn header_fault(t: &str) -> Option<String> {
     if t.starts_with("Invalid image dimensions") {
-        return corrupt("its header declares a width or height of 0 or above 2^31".into());
+        return Some(corrupt(
+            "its header declares a width or height of 0 or above 2^31".into(),
+        ));
     }
     if let Some(rest) = t.strip_prefix("Invalid color/depth combination in header: ") {
         let (c, d) = rest.split_once('/').unwrap_or((rest, ""));
@@ -239,50 +260,47 @@ fn png_format(text: &str) -> String {
             "Sixteen" => "16",
             other => other,
         };
-        return corrupt(format!(
+        return Some(corrupt(format!(
             "its header declares {colour} at {depth} bits per sample, which PNG does not allow"
-        ));
-    }
-    if let Some(n) = t.strip_prefix("Invalid bit depth ") {
-        return corrupt(format!(
-            "its header declares bit depth {n}, which PNG does not define"
-        ));
-    }
-    if let Some(n) = t.strip_prefix("Invalid color type ") {
-        return corrupt(format!(
-            "its header declares colour type {n}, which PNG does not define"
-        ));
-    }
-    if let Some(rest) = t.strip_prefix("Not enough palette entries, expect ") {
-        let (want, got) = rest.split_once(" got ").unwrap_or((rest, "fewer"));
-        return corrupt(format!(
-            "its palette has {got} entries, the image needs {want}"
-        ));
-    }
-    if t.starts_with("Missing palette of indexed image") {
-        return corrupt("an indexed-colour image without a palette (PLTE chunk)".into());
-    }
-    if let Some(c) = t.strip_prefix("Transparency chunk found for color type ") {
-        return corrupt(format!(
-            "a transparency (tRNS) chunk in a {} image, where PNG does not allow one",
-            c.to_ascii_lowercase()
-        ));
+        )));
     }
     for (prefix, what) in [
+        ("Invalid bit depth ", "bit depth"),
+        ("Invalid color type ", "colour type"),
+        // These three follow the palette faults in the `png` texts' order;
+        // no text starts with two of the prefixes, so the order is free.
         ("Unknown compression method ", "compression method"),
         ("Unknown filter method ", "filter method"),
         ("Unknown interlace method ", "interlace method"),
     ] {
         if let Some(n) = t.strip_prefix(prefix) {
-            return corrupt(format!(
+            return Some(corrupt(format!(
                 "its header declares {what} {n}, which PNG does not define"
-            ));
+            )));
         }
     }
-    if t.contains("tEXt") || t.contains("iTXt") || t.contains("compressed text") {
-        return corrupt(format!("a text chunk is invalid ({})", lower_first(t)));
+    None
+}
+
+/// A palette too short or missing for an indexed image, or a
+/// transparency chunk where PNG allows none.
+fn palette_fault(t: &str) -> Option<String> {
+    if let Some(rest) = t.strip_prefix("Not enough palette entries, expect ") {
+        let (want, got) = rest.split_once(" got ").unwrap_or((rest, "fewer"));
+        return Some(corrupt(format!(
+            "its palette has {got} entries, the image needs {want}"
+        )));
     }
-    corrupt(lower_first(&printable(&strip_debug(t))))
+    if t.starts_with("Missing palette of indexed image") {
+        return Some(corrupt(
+            "an indexed-colour image without a palette (PLTE chunk)".into(),
+        ));
+    }
+    let c = t.strip_prefix("Transparency chunk found for color type ")?;
+    Some(corrupt(format!(
+        "a transparency (tRNS) chunk in a {} image, where PNG does not allow one",
+        c.to_ascii_lowercase()
+    )))
 }
 
 /// The four-letter names in a `png` error's `ChunkType { type: IDAT, … }`

@@ -837,6 +837,194 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded> {
 fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
     let r = reader(bytes)?;
     let h = r.header();
+    refuse_image_kind(&h)?;
+    let scheme = u32::from_le_bytes(bytes[44..48].try_into().map_err(decode_err)?);
+    let vk = h.format.map(|f| f.value()).unwrap_or(0);
+    let block = block_format_of_vk(vk);
+    let mut format = match block {
+        Some((bf, srgb, _)) => bf.decoded_format(srgb),
+        None => format_of_vk(vk).ok_or_else(|| {
+            unsupported_format(vk, scheme, dfd_model_word(bytes).map(|w| w & 0xff))
+        })?,
+    };
+    let premultiplied = dfd_premultiplied(bytes);
+    let mut notes = Vec::new();
+    format = apply_swizzle(&r, format, block.is_some(), &mut notes);
+    if premultiplied && format.has_alpha() {
+        format = format.with_alpha(AlphaMode::Premultiplied);
+    }
+    let stored = StoredLevels {
+        width: h.pixel_width,
+        height: h.pixel_height.max(1),
+        scheme,
+        block,
+        format,
+        premultiplied,
+    };
+    stored.check_decoded_size(r.levels().len(), bytes.len(), limits)?;
+    let mut levels = Vec::new();
+    for (k, level) in r.levels().enumerate() {
+        levels.push(stored.read(k, &level, limits)?);
+    }
+    if levels.is_empty() {
+        return Err(decode_err("no levels"));
+    }
+    if let Some((_, v)) = r.key_value_data().find(|(k, _)| *k == "KTXorientation") {
+        let text = String::from_utf8_lossy(v)
+            .trim_end_matches('\0')
+            .to_string();
+        let (code, note) = orientation(&text, h.pixel_height > 0);
+        if code != 1 {
+            levels = levels
+                .iter()
+                .map(|l| super::orient(l, code))
+                .collect::<Result<_>>()?;
+        }
+        notes.extend(note);
+    }
+    let attributes = attributes_of(&r, vk, block, scheme);
+    let wrap = super::recorded_wrap(
+        attributes
+            .iter()
+            .find(|(k, _)| k == "parvo:wrapmodes")
+            .map(|(_, v)| v.as_str()),
+        &mut notes,
+    );
+    let format = levels.first().map_or(format, |l| l.format());
+    let mut info = SourceInfo::new(FileFormat::Ktx2, &format);
+    info.notes = notes;
+    info.channel_names = match (format.channels, format.has_alpha()) {
+        (1, _) => vec!["R".into()],
+        (2, false) => vec!["R".into(), "G".into()],
+        _ => super::layout_names(&format),
+    };
+    info.own_mips = levels.len() > 1;
+    info.blocks = block.map(|b| b.0);
+    info.wrap = wrap;
+    info.attributes = attributes;
+    Ok(Loaded { levels, info })
+}
+
+/// How a file's levels are stored, from its header: what sizing,
+/// inflating and decoding them needs.
+struct StoredLevels {
+    /// Level 0's size (a 1-D texture has height 1).
+    width: u32,
+    height: u32,
+    /// The supercompression scheme (0: none).
+    scheme: u32,
+    /// The block format, sRGB, and whether it has alpha; `None` for plain
+    /// texels of `format`.
+    block: Option<(BlockFormat, bool, bool)>,
+    /// The texel format the levels decode to.
+    format: Format,
+    /// The DFD says alpha is premultiplied.
+    premultiplied: bool,
+}
+
+impl StoredLevels {
+    /// The size of level `k` (rounded down, as KTX 2.0 defines).
+    fn size(&self, k: usize) -> (u32, u32) {
+        crate::mip::level_size(
+            self.width,
+            self.height,
+            k as u32,
+            crate::mip::Rounding::Down,
+        )
+    }
+
+    /// Bytes of a `w × h` level as stored (before supercompression).
+    fn stored_len(&self, (w, h): (u32, u32)) -> u64 {
+        match self.block {
+            Some((bf, ..)) => bf.level_bytes(w, h),
+            None => w as u64 * h as u64 * self.format.texel_bytes() as u64,
+        }
+    }
+
+    /// Hold what decoding `count` levels of a file of `file_len` bytes
+    /// allocates to `limits`, from the header alone: the decoded texels
+    /// of every level, the file, and one inflated level when
+    /// supercompressed (block formats decode to 4-16 times their stored
+    /// bytes, and supercompressed levels can be thousands of times the
+    /// file's).
+    fn check_decoded_size(&self, count: usize, file_len: usize, limits: &Limits) -> Result<()> {
+        let decoded: u64 = (0..count)
+            .map(|k| {
+                let (lw, lh) = self.size(k);
+                (lw as u64 * lh as u64).saturating_mul(self.format.texel_bytes() as u64)
+            })
+            .fold(0, u64::saturating_add);
+        let inflated = if self.scheme != 0 {
+            self.stored_len(self.size(0))
+        } else {
+            0
+        };
+        limits.check(
+            self.width as u64,
+            self.height as u64,
+            decoded
+                .saturating_add(file_len as u64)
+                .saturating_add(inflated),
+        )
+    }
+
+    /// Level `k`: inflated when supercompressed, its length checked,
+    /// decoded.
+    fn read(&self, k: usize, level: &::ktx2::Level<'_>, limits: &Limits) -> Result<Texture> {
+        let (lw, lh) = self.size(k);
+        let need = self.stored_len((lw, lh));
+        let unpacked;
+        let data: &[u8] = if self.scheme != 0 {
+            // The declared length is what gets allocated: it must be the
+            // level's size before anything is inflated.
+            if level.uncompressed_byte_length != need {
+                return Err(decode_err(format!(
+                    "level {k} declares {} bytes uncompressed, a {lw}x{lh} level has {need}",
+                    level.uncompressed_byte_length
+                )));
+            }
+            unpacked = decompress(self.scheme, level.data, need, limits)?;
+            &unpacked
+        } else {
+            level.data
+        };
+        if data.len() as u64 != need {
+            return Err(decode_err(match self.block {
+                Some((bf, ..)) => format!(
+                    "level {k} has {} bytes, a {lw}x{lh} {bf} level needs {need}",
+                    data.len()
+                ),
+                None => format!("level {k} has {} bytes, {lw}x{lh} needs {need}", data.len()),
+            }));
+        }
+        self.decode(data, (lw, lh))
+    }
+
+    /// One `w × h` level from its stored bytes (inflated, of the right
+    /// length): BC blocks decoded, plain texels read little-endian.
+    fn decode(&self, data: &[u8], (w, h): (u32, u32)) -> Result<Texture> {
+        match self.block {
+            Some((bf, srgb, has_alpha)) => {
+                let alpha = if !has_alpha {
+                    // BC1_RGB: alpha is 1 whatever the blocks say.
+                    AlphaMode::None
+                } else if self.premultiplied {
+                    AlphaMode::Premultiplied
+                } else {
+                    AlphaMode::Straight
+                };
+                crate::compress::decode(bf, srgb, alpha, w, h, data)
+            }
+            None => {
+                let texels = super::texels_from_le(self.format.channel_type, data);
+                Texture::from_texels(w, h, self.format, texels)
+            }
+        }
+    }
+}
+
+/// Refuse what is not one 2-D texture: cube maps, volumes, arrays.
+fn refuse_image_kind(h: &::ktx2::Header) -> Result<()> {
     if h.face_count == 6 {
         return Err(decode_err(
             "cube maps are not supported (parvo reads 2-D textures)",
@@ -861,20 +1049,20 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
             h.layer_count
         )));
     }
-    let scheme = u32::from_le_bytes(bytes[44..48].try_into().map_err(decode_err)?);
-    let vk = h.format.map(|f| f.value()).unwrap_or(0);
-    let block = block_format_of_vk(vk);
-    let mut format = match block {
-        Some((bf, srgb, _)) => bf.decoded_format(srgb),
-        None => format_of_vk(vk).ok_or_else(|| {
-            unsupported_format(vk, scheme, dfd_model_word(bytes).map(|w| w & 0xff))
-        })?,
-    };
-    let premultiplied = dfd_premultiplied(bytes);
-    // `KTXswizzle` (KTX 2.0 section "KTXswizzle"): `rrrg` on a two-channel
-    // format is the specification's luminance + alpha; the other mappings
-    // that keep the stored channels' meaning need nothing, and any other
-    // is reported, not applied.
+    Ok(())
+}
+
+/// `format` as the file's `KTXswizzle` (KTX 2.0 section "KTXswizzle")
+/// reads it: `rrrg` on a two-channel plain format is the specification's
+/// luminance + alpha; the other mappings that keep the stored channels'
+/// meaning need nothing, and any other is reported in `notes`, not
+/// applied.
+fn apply_swizzle(
+    r: &::ktx2::Reader<&[u8]>,
+    format: Format,
+    blocks: bool,
+    notes: &mut Vec<String>,
+) -> Format {
     let swizzle = r
         .key_value_data()
         .find(|(k, _)| *k == "KTXswizzle")
@@ -883,111 +1071,30 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
                 .trim_end_matches('\0')
                 .to_string()
         });
-    let mut notes = Vec::new();
-    if let Some(sw) = &swizzle {
-        let identity = ["r001", "rg01", "rgb1", "rgba"][(format.channels as usize).clamp(1, 4) - 1];
-        if format.channels == 2 && sw == "rrrg" && block.is_none() {
-            format = format.with_alpha(AlphaMode::Straight);
-        } else if sw != identity && sw != "rgba" && !(format.channels == 1 && sw == "rrr1") {
-            notes.push(format!(
-                "KTXswizzle `{sw}` is not applied: the channels are read as stored"
-            ));
-        }
-    }
-    if premultiplied && format.has_alpha() {
-        format = format.with_alpha(AlphaMode::Premultiplied);
-    }
-    let (w, hgt) = (h.pixel_width, h.pixel_height.max(1));
-    let size = |k: usize| crate::mip::level_size(w, hgt, k as u32, crate::mip::Rounding::Down);
-    // Bytes of level k as stored (before supercompression).
-    let stored_len = |(lw, lh): (u32, u32)| match block {
-        Some((bf, ..)) => bf.level_bytes(lw, lh),
-        None => lw as u64 * lh as u64 * format.texel_bytes() as u64,
+    let Some(sw) = &swizzle else {
+        return format;
     };
-    // What decoding allocates, from the header alone: the decoded texels
-    // of every level, the file, and one inflated level when supercompressed
-    // (block formats decode to 4-16 times their stored bytes, and
-    // supercompressed levels can be thousands of times the file's).
-    let decoded: u64 = (0..r.levels().len())
-        .map(|k| {
-            let (lw, lh) = size(k);
-            (lw as u64 * lh as u64).saturating_mul(format.texel_bytes() as u64)
-        })
-        .fold(0, u64::saturating_add);
-    let inflated = if scheme != 0 { stored_len(size(0)) } else { 0 };
-    limits.check(
-        w as u64,
-        hgt as u64,
-        decoded
-            .saturating_add(bytes.len() as u64)
-            .saturating_add(inflated),
-    )?;
-    let mut levels = Vec::new();
-    for (k, level) in r.levels().enumerate() {
-        let (lw, lh) = size(k);
-        let need = stored_len((lw, lh));
-        let unpacked;
-        let data: &[u8] = if scheme != 0 {
-            // The declared length is what gets allocated: it must be the
-            // level's size before anything is inflated.
-            if level.uncompressed_byte_length != need {
-                return Err(decode_err(format!(
-                    "level {k} declares {} bytes uncompressed, a {lw}x{lh} level has {need}",
-                    level.uncompressed_byte_length
-                )));
-            }
-            unpacked = decompress(scheme, level.data, need, limits)?;
-            &unpacked
-        } else {
-            level.data
-        };
-        let level_tex = match block {
-            Some((bf, srgb, has_alpha)) => {
-                if data.len() as u64 != need {
-                    return Err(decode_err(format!(
-                        "level {k} has {} bytes, a {lw}x{lh} {bf} level needs {need}",
-                        data.len()
-                    )));
-                }
-                let alpha = if !has_alpha {
-                    // BC1_RGB: alpha is 1 whatever the blocks say.
-                    AlphaMode::None
-                } else if premultiplied {
-                    AlphaMode::Premultiplied
-                } else {
-                    AlphaMode::Straight
-                };
-                crate::compress::decode(bf, srgb, alpha, lw, lh, data)?
-            }
-            None => {
-                if data.len() as u64 != need {
-                    return Err(decode_err(format!(
-                        "level {k} has {} bytes, {lw}x{lh} needs {need}",
-                        data.len()
-                    )));
-                }
-                let texels = super::texels_from_le(format.channel_type, data);
-                Texture::from_texels(lw, lh, format, texels)?
-            }
-        };
-        levels.push(level_tex);
+    let identity = ["r001", "rg01", "rgb1", "rgba"][(format.channels as usize).clamp(1, 4) - 1];
+    if format.channels == 2 && sw == "rrrg" && !blocks {
+        return format.with_alpha(AlphaMode::Straight);
     }
-    if levels.is_empty() {
-        return Err(decode_err("no levels"));
+    if sw != identity && sw != "rgba" && !(format.channels == 1 && sw == "rrr1") {
+        notes.push(format!(
+            "KTXswizzle `{sw}` is not applied: the channels are read as stored"
+        ));
     }
-    if let Some((_, v)) = r.key_value_data().find(|(k, _)| *k == "KTXorientation") {
-        let text = String::from_utf8_lossy(v)
-            .trim_end_matches('\0')
-            .to_string();
-        let (code, note) = orientation(&text, h.pixel_height > 0);
-        if code != 1 {
-            levels = levels
-                .iter()
-                .map(|l| super::orient(l, code))
-                .collect::<Result<_>>()?;
-        }
-        notes.extend(note);
-    }
+    format
+}
+
+/// The attributes `parvo info` shows, sorted: the key/value data (text,
+/// or its length when binary), the vkFormat, the block format stored and
+/// the supercompression.
+fn attributes_of(
+    r: &::ktx2::Reader<&[u8]>,
+    vk: u32,
+    block: Option<(BlockFormat, bool, bool)>,
+    scheme: u32,
+) -> Vec<(String, String)> {
     let mut attributes: Vec<(String, String)> = r
         .key_value_data()
         .map(|(k, v)| {
@@ -1019,26 +1126,7 @@ fn load_bytes(bytes: &[u8], limits: &Limits) -> Result<Loaded> {
         ));
     }
     attributes.sort();
-    let wrap = super::recorded_wrap(
-        attributes
-            .iter()
-            .find(|(k, _)| k == "parvo:wrapmodes")
-            .map(|(_, v)| v.as_str()),
-        &mut notes,
-    );
-    let format = levels.first().map_or(format, |l| l.format());
-    let mut info = SourceInfo::new(FileFormat::Ktx2, &format);
-    info.notes = notes;
-    info.channel_names = match (format.channels, format.has_alpha()) {
-        (1, _) => vec!["R".into()],
-        (2, false) => vec!["R".into(), "G".into()],
-        _ => super::layout_names(&format),
-    };
-    info.own_mips = levels.len() > 1;
-    info.blocks = block.map(|b| b.0);
-    info.wrap = wrap;
-    info.attributes = attributes;
-    Ok(Loaded { levels, info })
+    attributes
 }
 
 /// KTX 2.0 in the container table: reads and writes every vkFormat parvo

@@ -295,18 +295,22 @@ impl fmt::Display for Environment {
 }
 
 /// What a loader does with an environment map (a cube-face or lat-long
-/// OpenEXR or TIFF): nothing in parvo filters or samples one as what it
-/// is yet, and taking it for a plain texture filters a cube's faces
+/// OpenEXR or TIFF): taking it for a plain texture filters a cube's faces
 /// into each other and wraps a lat-long map's poles, so the default
 /// refuses it. Describing it (what `parvo info` does) loads its texels
-/// as stored with [`SourceInfo::environment`] set and a note.
+/// as stored with [`SourceInfo::environment`] set and a note; accepting
+/// it (what a direction lookup, [`crate::env`], does) loads them marked,
+/// without a note.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum EnvironmentMaps {
     /// Refuse the file with an error naming the kind (the default).
     #[default]
     Refuse,
-    /// Load it as stored, marked as an environment map.
+    /// Load it as stored, marked as an environment map, with a note.
     Describe,
+    /// Load it as stored, marked as an environment map: the caller
+    /// samples it as one.
+    Accept,
 }
 
 /// Refuse an environment map of `kind` or note it, as `options` say;
@@ -322,7 +326,7 @@ pub(crate) fn environment_map(
         EnvironmentMaps::Refuse => Err(Error::Decode {
             format,
             reason: format!(
-                "a {kind} environment map ({detail}), which parvo cannot filter or sample yet: \
+                "a {kind} environment map ({detail}), which parvo can sample by direction only: \
                  filtering it as a flat image would blend {}",
                 match kind {
                     Environment::Cube => "its six faces into each other across their edges",
@@ -332,11 +336,12 @@ pub(crate) fn environment_map(
         }),
         EnvironmentMaps::Describe => {
             notes.push(format!(
-                "{kind} environment map ({detail}): described only; parvo cannot filter or \
-                 sample environment maps yet"
+                "{kind} environment map ({detail}): described only; parvo samples it by \
+                 direction but does not build its levels yet"
             ));
             Ok(())
         }
+        EnvironmentMaps::Accept => Ok(()),
     }
 }
 

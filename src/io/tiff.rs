@@ -99,6 +99,28 @@ struct Directory {
     bit_reversed: bool,
 }
 
+impl Directory {
+    /// What level 0's tags leave to an assumption, as notes: alpha taken
+    /// without an ExtraSamples tag, a colour map rounded to 8 bits.
+    fn notes(&self, notes: &mut Vec<String>) {
+        if let Some(n) = self.alpha_note {
+            notes.push(format!(
+                "{n} ({} straight or none overrides)",
+                Setting::Alpha
+            ));
+        }
+        if let Some(map) = &self.palette
+            && map.iter().any(|&v| v % 257 != 0)
+        {
+            notes.push(
+                "palette TIFF: the colour map's 16-bit entries are rounded down to 8 bits, as \
+                 OpenImageIO reads them"
+                    .into(),
+            );
+        }
+    }
+}
+
 fn ascii_tag<R: Read + Seek>(d: &mut Decoder<R>, tag: Tag) -> Option<String> {
     match d.find_tag(tag).ok().flatten()? {
         ::tiff::decoder::ifd::Value::Ascii(s) => Some(s.trim_end_matches('\0').to_string()),
@@ -148,7 +170,7 @@ impl Reader<'_> {
                 "channels of different sample formats (integer and float) are not supported",
             ));
         }
-        let bits = bits[0];
+        let (bits, sample_format) = (bits[0], sample_format[0]);
         let mut extra: Vec<u16> = d
             .find_tag_unsigned_vec::<u16>(Tag::ExtraSamples)
             .map_err(|e| self.err(e))?
@@ -162,133 +184,25 @@ impl Reader<'_> {
             Some(p) => p,
             None => fix.told.unwrap_or(1) as u64,
         };
-        let colour = match photometric {
-            1 | 3 => 1,
-            2 => 3,
-            // The crate inverts one WhiteIsZero channel (as libtiff
-            // and OpenImageIO read it: 0 is white).
-            0 if stored_samples == 1 && matches!(bits, 1 | 2 | 4 | 8 | 16 | 32 | 64) => 1,
-            0 if stored_samples == 1 => {
-                return Err(decode_err(format!(
-                    "WhiteIsZero (inverted grey) TIFF of {}-bit samples is not supported (1, 2, \
-                     4, 8 and 16 bits are)",
-                    bits
-                )));
-            }
-            0 => {
-                return Err(decode_err(
-                    "WhiteIsZero (inverted grey) TIFF with an alpha or extra channel is not \
-                     supported",
-                ));
-            }
-            4 => return Err(decode_err("transparency-mask TIFF is not supported")),
-            5 => return Err(decode_err("CMYK TIFF is not supported")),
-            6 => return Err(decode_err("YCbCr TIFF is not supported (store it as RGB)")),
-            8..=10 => return Err(decode_err("CIE L*a*b* TIFF is not supported")),
-            32844 | 32845 => return Err(decode_err("LogLuv (SGI) TIFF is not supported")),
-            u64::MAX => {
-                return Err(decode_err(
-                    "the PhotometricInterpretation tag does not hold one number",
-                ));
-            }
-            p => {
-                return Err(decode_err(format!(
-                    "photometric interpretation {p} is not supported"
-                )));
-            }
-        };
-        // FillOrder 2 stores the bits of each byte in reverse; libtiff
-        // reverses them before decoding, which for uncompressed data
-        // without a predictor is reversing the decoded bytes.
-        let bit_reversed = match self.unsigned(d, Tag::FillOrder)?.unwrap_or(1) {
-            1 => false,
-            2 if self.unsigned(d, Tag::Compression)?.unwrap_or(1) == 1
-                && self.unsigned(d, Tag::Predictor)?.unwrap_or(1) == 1 =>
-            {
-                true
-            }
-            2 => {
-                return Err(decode_err(
-                    "FillOrder 2 (bits stored least significant first) is supported for \
-                     uncompressed data without a predictor only",
-                ));
-            }
-            f => return Err(decode_err(format!("FillOrder {f} is neither 1 nor 2"))),
-        };
+        let colour = colour_channels(photometric, stored_samples, bits)?;
+        let bit_reversed = self.bit_reversed(d)?;
         if !(1..=4).contains(&stored_samples) || stored_samples < colour {
             return Err(decode_err(format!(
                 "{stored_samples} samples per pixel: parvo reads 1 to 4 channels"
             )));
         }
         let palette = if photometric == 3 {
-            if stored_samples != 1 || !matches!(bits, 1 | 2 | 4 | 8 | 16) || sample_format[0] != 1 {
-                return Err(decode_err(format!(
-                    "a palette image of {stored_samples} samples of {bits} bits is not supported \
-                     (one index of 1, 2, 4, 8 or 16 bits is)"
-                )));
-            }
-            let map = d
-                .find_tag_unsigned_vec::<u16>(Tag::ColorMap)
-                .map_err(|e| self.err(e))?
-                .ok_or_else(|| decode_err("a palette image without a ColorMap tag"))?;
-            let want = 3usize << bits;
-            if map.len() != want {
-                return Err(decode_err(format!(
-                    "the ColorMap has {} entries, a palette of {bits}-bit indices has {want}",
-                    map.len()
-                )));
-            }
-            Some(map)
+            Some(self.palette(d, stored_samples, bits, sample_format)?)
         } else {
             None
         };
-        let ty = match (sample_format[0], bits) {
-            _ if palette.is_some() => ChannelType::U8,
-            (1, 1..=7) if stored_samples == 1 => ChannelType::U8,
-            (1, 8) => ChannelType::U8,
-            (1, 16) => ChannelType::U16,
-            (3, 16) => ChannelType::F16,
-            (3, 32) | (3, 64) => ChannelType::F32,
-            (1, b) if b < 8 => {
-                return Err(decode_err(format!(
-                    "{b}-bit samples are supported for one grey channel, not for {stored_samples} \
-                     channels"
-                )));
-            }
-            (1, b) => {
-                return Err(decode_err(format!(
-                    "{b}-bit unsigned integer samples are not supported (8 and 16 are)"
-                )));
-            }
-            (2, b) => {
-                return Err(decode_err(format!(
-                    "signed {b}-bit samples are not supported"
-                )));
-            }
-            (f, b) => {
-                return Err(decode_err(format!(
-                    "sample format {f} with {b} bits is not supported"
-                )));
-            }
-        };
+        let ty = channel_type(sample_format, bits, stored_samples, palette.is_some())?;
         let has_alpha_slot = stored_samples == 2 || stored_samples == 4;
         let (alpha, alpha_note) = if missing && stored_samples == 2 && extra.is_empty() {
             // OpenImageIO reads two untagged channels as R, G data.
             (AlphaMode::None, None)
         } else if stored_samples > colour {
-            match extra.first() {
-                Some(1) => (AlphaMode::Premultiplied, None),
-                Some(2) => (AlphaMode::Straight, None),
-                Some(_) => (AlphaMode::None, None),
-                None if has_alpha_slot => (
-                    AlphaMode::Premultiplied,
-                    Some(
-                        "no ExtraSamples tag: the last channel is taken as associated alpha, as \
-                         OpenImageIO does",
-                    ),
-                ),
-                None => (AlphaMode::None, None),
-            }
+            extra_alpha(extra.first().copied(), has_alpha_slot)
         } else {
             (AlphaMode::Straight, None)
         };
@@ -334,6 +248,101 @@ impl Reader<'_> {
             palette,
             bit_reversed,
         })
+    }
+
+    /// `FillOrder` 2 stores the bits of each byte in reverse; libtiff
+    /// reverses them before decoding, which for uncompressed data without
+    /// a predictor is reversing the decoded bytes (`true`); other data in
+    /// that order is refused.
+    fn bit_reversed<R: Read + Seek>(&self, d: &mut Decoder<R>) -> Result<bool> {
+        match self.unsigned(d, Tag::FillOrder)?.unwrap_or(1) {
+            1 => Ok(false),
+            2 if self.unsigned(d, Tag::Compression)?.unwrap_or(1) == 1
+                && self.unsigned(d, Tag::Predictor)?.unwrap_or(1) == 1 =>
+            {
+                Ok(true)
+            }
+            2 => Err(decode_err(
+                "FillOrder 2 (bits stored least significant first) is supported for \
+                 uncompressed data without a predictor only",
+            )),
+            f => Err(decode_err(format!("FillOrder {f} is neither 1 nor 2"))),
+        }
+    }
+
+    /// A palette image's colour map (red, green and blue tables of 2^bits
+    /// entries each), after checking that its texels are one index of 1,
+    /// 2, 4, 8 or 16 bits.
+    fn palette<R: Read + Seek>(
+        &self,
+        d: &mut Decoder<R>,
+        stored_samples: usize,
+        bits: u16,
+        sample_format: u16,
+    ) -> Result<Vec<u16>> {
+        if stored_samples != 1 || !matches!(bits, 1 | 2 | 4 | 8 | 16) || sample_format != 1 {
+            return Err(decode_err(format!(
+                "a palette image of {stored_samples} samples of {bits} bits is not supported \
+                 (one index of 1, 2, 4, 8 or 16 bits is)"
+            )));
+        }
+        let map = d
+            .find_tag_unsigned_vec::<u16>(Tag::ColorMap)
+            .map_err(|e| self.err(e))?
+            .ok_or_else(|| decode_err("a palette image without a ColorMap tag"))?;
+        let want = 3usize << bits;
+        if map.len() != want {
+            return Err(decode_err(format!(
+                "the ColorMap has {} entries, a palette of {bits}-bit indices has {want}",
+                map.len()
+            )));
+        }
+        Ok(map)
+    }
+
+    /// The attributes `parvo info` shows, sorted: the text tags, Pixar's
+    /// `textureformat` and `wrapmodes`, the compression and a non-default
+    /// orientation.
+    fn attributes<R: Read + Seek>(
+        &self,
+        d: &mut Decoder<R>,
+        dir: &Directory,
+        texture_format: &Option<String>,
+        wrap_text: &Option<String>,
+    ) -> Result<Vec<(String, String)>> {
+        let mut attributes: Vec<(String, String)> = Vec::new();
+        for (name, tag) in [
+            ("ImageDescription", Tag::ImageDescription),
+            ("Software", Tag::Software),
+            ("DateTime", Tag::DateTime),
+            ("Artist", Tag::Artist),
+        ] {
+            if let Some(v) = ascii_tag(d, tag) {
+                attributes.push((name.into(), v));
+            }
+        }
+        if let Some(t) = texture_format {
+            attributes.push(("textureformat".into(), t.clone()));
+        }
+        if let Some(w) = wrap_text {
+            attributes.push(("wrapmodes".into(), w.clone()));
+        }
+        if let Some(c) = self.unsigned(d, Tag::Compression)? {
+            let name = match c {
+                1 => "none".to_string(),
+                5 => "lzw".into(),
+                7 => "jpeg".into(),
+                8 | 32946 => "zip".into(),
+                32773 => "packbits".into(),
+                other => other.to_string(),
+            };
+            attributes.push(("compression".into(), name));
+        }
+        if dir.orientation != 1 {
+            attributes.push(("Orientation".into(), dir.orientation.to_string()));
+        }
+        attributes.sort();
+        Ok(attributes)
     }
 
     /// Decode the directory the decoder is at: every plane of a planar
@@ -414,6 +423,99 @@ impl Reader<'_> {
             }
         };
         Texture::from_texels(dir.width, dir.height, dir.format, texels)
+    }
+}
+
+/// The colour channels a `PhotometricInterpretation` means (1 grey or
+/// palette index, 3 RGB); the interpretations parvo does not read are
+/// refused in words.
+fn colour_channels(photometric: u64, stored_samples: usize, bits: u16) -> Result<usize> {
+    match photometric {
+        1 | 3 => Ok(1),
+        2 => Ok(3),
+        // The crate inverts one WhiteIsZero channel (as libtiff
+        // and OpenImageIO read it: 0 is white).
+        0 if stored_samples == 1 && matches!(bits, 1 | 2 | 4 | 8 | 16 | 32 | 64) => Ok(1),
+        0 if stored_samples == 1 => Err(decode_err(format!(
+            "WhiteIsZero (inverted grey) TIFF of {}-bit samples is not supported (1, 2, \
+             4, 8 and 16 bits are)",
+            bits
+        ))),
+        0 => Err(decode_err(
+            "WhiteIsZero (inverted grey) TIFF with an alpha or extra channel is not \
+             supported",
+        )),
+        4 => Err(decode_err("transparency-mask TIFF is not supported")),
+        5 => Err(decode_err("CMYK TIFF is not supported")),
+        6 => Err(decode_err("YCbCr TIFF is not supported (store it as RGB)")),
+        8..=10 => Err(decode_err("CIE L*a*b* TIFF is not supported")),
+        32844 | 32845 => Err(decode_err("LogLuv (SGI) TIFF is not supported")),
+        u64::MAX => Err(decode_err(
+            "the PhotometricInterpretation tag does not hold one number",
+        )),
+        p => Err(decode_err(format!(
+            "photometric interpretation {p} is not supported"
+        ))),
+    }
+}
+
+/// The channel type samples of `sample_format` (1 unsigned, 2 signed, 3
+/// float) and `bits` load as: u8 for palette indices and sub-byte grey,
+/// u16, f16, or f32 (also for f64); the others are refused in words.
+fn channel_type(
+    sample_format: u16,
+    bits: u16,
+    stored_samples: usize,
+    palette: bool,
+) -> Result<ChannelType> {
+    Ok(match (sample_format, bits) {
+        _ if palette => ChannelType::U8,
+        (1, 1..=7) if stored_samples == 1 => ChannelType::U8,
+        (1, 8) => ChannelType::U8,
+        (1, 16) => ChannelType::U16,
+        (3, 16) => ChannelType::F16,
+        (3, 32) | (3, 64) => ChannelType::F32,
+        (1, b) if b < 8 => {
+            return Err(decode_err(format!(
+                "{b}-bit samples are supported for one grey channel, not for {stored_samples} \
+                 channels"
+            )));
+        }
+        (1, b) => {
+            return Err(decode_err(format!(
+                "{b}-bit unsigned integer samples are not supported (8 and 16 are)"
+            )));
+        }
+        (2, b) => {
+            return Err(decode_err(format!(
+                "signed {b}-bit samples are not supported"
+            )));
+        }
+        (f, b) => {
+            return Err(decode_err(format!(
+                "sample format {f} with {b} bits is not supported"
+            )));
+        }
+    })
+}
+
+/// What the first `ExtraSamples` value says the channel after the colour
+/// is: 1 associated alpha, 2 unassociated alpha, other values data;
+/// without the tag, a second or fourth channel (`has_alpha_slot`) is
+/// associated alpha, OpenImageIO's assumption, with a note saying so.
+fn extra_alpha(extra: Option<u16>, has_alpha_slot: bool) -> (AlphaMode, Option<&'static str>) {
+    match extra {
+        Some(1) => (AlphaMode::Premultiplied, None),
+        Some(2) => (AlphaMode::Straight, None),
+        Some(_) => (AlphaMode::None, None),
+        None if has_alpha_slot => (
+            AlphaMode::Premultiplied,
+            Some(
+                "no ExtraSamples tag: the last channel is taken as associated alpha, as \
+                 OpenImageIO does",
+            ),
+        ),
+        None => (AlphaMode::None, None),
     }
 }
 
@@ -596,27 +698,91 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     let chain = chain::walk(&mut file, len).map_err(decode_err)?;
     let l = chain.layout;
     let pages = chain.dirs.len();
-    let texture_format = chain.dirs[0].entry(tag::TEXTURE_FORMAT).is_some();
-    let mipmapped = texture_format;
-    let first = if mipmapped { 0 } else { options.subimage };
-    if first >= pages {
-        return Err(Error::InvalidOption(format!(
-            "{} {first}: the file has {pages} page{}",
-            Setting::Subimage,
-            if pages == 1 { "" } else { "s" }
-        )));
-    }
-    if mipmapped && options.subimage != 0 {
-        return Err(Error::InvalidOption(format!(
-            "{}: this TIFF is a mip-mapped texture, its directories are its levels",
-            Setting::Subimage
-        )));
-    }
-    let count = if mipmapped { pages } else { 1 };
+    // A texture: its first directory has Pixar's `textureformat` tag.
+    let mipmapped = chain.dirs[0].entry(tag::TEXTURE_FORMAT).is_some();
+    let (first, count) = directories_read(pages, mipmapped, options)?;
     for d in &chain.dirs[first..first + count] {
         chain::check_extents(&mut file, &l, d).map_err(decode_err)?;
     }
     let (view, fixes, fix_notes) = chain.repair(open()?).map_err(decode_err)?;
+    let mut notes = chain_notes(&chain, fix_notes, first, mipmapped);
+    let reader = |k: usize| Reader {
+        raw: &chain.dirs[k],
+        layout: l,
+        limits,
+    };
+    let mut d = Decoder::new(BufReader::new(view))
+        .map_err(|e| reader(0).err(e))?
+        .with_limits(decoder_limits(limits, len));
+    d.seek_to_image(first).map_err(|e| reader(first).err(e))?;
+    let r0 = reader(first);
+    let dir0 = r0.directory(&mut d, fixes[first])?;
+    let texture_format = ascii_tag(&mut d, Tag::Unknown(tag::TEXTURE_FORMAT));
+    let wrap_text = ascii_tag(&mut d, Tag::Unknown(tag::WRAP_MODES));
+    let attributes = r0.attributes(&mut d, &dir0, &texture_format, &wrap_text)?;
+    let env = environment(texture_format.as_deref());
+    if let Some(kind) = env {
+        super::environment_map(
+            "TIFF",
+            kind,
+            &format!(
+                "textureformat \"{}\", {}x{}",
+                texture_format.as_deref().unwrap_or(""),
+                dir0.width,
+                dir0.height
+            ),
+            options,
+            &mut notes,
+        )?;
+    }
+    check_levels(&dir0, count, limits)?;
+    dir0.notes(&mut notes);
+    let mut levels = vec![r0.texture(&mut d, &dir0)?];
+    let mut rounding = Rounding::Down;
+    for (k, &fix) in fixes.iter().enumerate().take(count).skip(1) {
+        d.seek_to_image(k).map_err(|e| reader(k).err(e))?;
+        let rk = reader(k);
+        let dir = rk.directory(&mut d, fix)?;
+        if k == 1 {
+            rounding = level_rounding(&dir0, &dir).unwrap_or(rounding);
+        }
+        let want = crate::mip::level_size(dir0.width, dir0.height, k as u32, rounding);
+        if (dir.width, dir.height) != want || dir.format != dir0.format {
+            return Err(decode_err(format!(
+                "mip level {k} is {}x{} {}, level 0 implies {}x{} {}",
+                dir.width, dir.height, dir.format, want.0, want.1, dir0.format
+            )));
+        }
+        levels.push(rk.texture(&mut d, &dir)?);
+    }
+    if dir0.orientation != 1 {
+        apply_orientation(&mut levels, dir0.orientation, options, &mut notes)?;
+    }
+    let format = levels[0].format();
+    let mut info = SourceInfo::new(FileFormat::Tiff, &format);
+    info.own_mips = levels.len() > 1;
+    info.rounding = rounding;
+    info.wrap = super::recorded_wrap(wrap_text.as_deref(), &mut notes);
+    info.tile = dir0.tile;
+    info.attributes = attributes;
+    info.environment = env;
+    info.notes = notes;
+    // TIFF names no transfer parvo reads: its values are taken as they
+    // are (linear), as OpenImageIO reads them, and that is an assumption.
+    info.color_stated = false;
+    Ok(Loaded { levels, info })
+}
+
+/// The notes of walking and repairing the chain of directories: of the
+/// page read only, unless all are read (a mip-mapped texture); a note
+/// that the file has other pages.
+fn chain_notes(
+    chain: &chain::Chain,
+    fix_notes: Vec<String>,
+    first: usize,
+    mipmapped: bool,
+) -> Vec<String> {
+    let pages = chain.dirs.len();
     let mut notes = Vec::new();
     if !mipmapped && pages > 1 {
         notes.push(format!(
@@ -637,72 +803,49 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
                 .map(|n| n.trim_start_matches(&prefix).to_string()),
         );
     }
-    let reader = |k: usize| Reader {
-        raw: &chain.dirs[k],
-        layout: l,
-        limits,
-    };
+    notes
+}
+
+/// Which of `pages` directories are read, as (first, count): all of a
+/// mip-mapped texture, else the one page `options.subimage` picks.
+fn directories_read(
+    pages: usize,
+    mipmapped: bool,
+    options: &LoadOptions,
+) -> Result<(usize, usize)> {
+    let first = if mipmapped { 0 } else { options.subimage };
+    if first >= pages {
+        return Err(Error::InvalidOption(format!(
+            "{} {first}: the file has {pages} page{}",
+            Setting::Subimage,
+            if pages == 1 { "" } else { "s" }
+        )));
+    }
+    if mipmapped && options.subimage != 0 {
+        return Err(Error::InvalidOption(format!(
+            "{}: this TIFF is a mip-mapped texture, its directories are its levels",
+            Setting::Subimage
+        )));
+    }
+    Ok((first, if mipmapped { pages } else { 1 }))
+}
+
+/// The `tiff` crate's limits: its decoding buffers held to the allocation
+/// limit; a tag's values to the file's length (at least the crate's own
+/// default, at most the allocation limit).
+fn decoder_limits(limits: &Limits, len: u64) -> ::tiff::decoder::Limits {
     let mut tl = ::tiff::decoder::Limits::default();
     tl.decoding_buffer_size = usize::try_from(limits.max_alloc).unwrap_or(usize::MAX);
     tl.intermediate_buffer_size = tl.decoding_buffer_size;
     tl.ifd_value_size =
         usize::try_from(len.min(limits.max_alloc).max(CRATE_TAG_LIMIT)).unwrap_or(usize::MAX);
-    let mut d = Decoder::new(BufReader::new(view))
-        .map_err(|e| reader(0).err(e))?
-        .with_limits(tl);
-    d.seek_to_image(first).map_err(|e| reader(first).err(e))?;
-    let r0 = reader(first);
-    let dir0 = r0.directory(&mut d, fixes[first])?;
-    let texture_format = ascii_tag(&mut d, Tag::Unknown(tag::TEXTURE_FORMAT));
-    let wrap_text = ascii_tag(&mut d, Tag::Unknown(tag::WRAP_MODES));
-    let mut attributes: Vec<(String, String)> = Vec::new();
-    for (name, tag) in [
-        ("ImageDescription", Tag::ImageDescription),
-        ("Software", Tag::Software),
-        ("DateTime", Tag::DateTime),
-        ("Artist", Tag::Artist),
-    ] {
-        if let Some(v) = ascii_tag(&mut d, tag) {
-            attributes.push((name.into(), v));
-        }
-    }
-    if let Some(t) = &texture_format {
-        attributes.push(("textureformat".into(), t.clone()));
-    }
-    if let Some(w) = &wrap_text {
-        attributes.push(("wrapmodes".into(), w.clone()));
-    }
-    if let Some(c) = r0.unsigned(&mut d, Tag::Compression)? {
-        let name = match c {
-            1 => "none".to_string(),
-            5 => "lzw".into(),
-            7 => "jpeg".into(),
-            8 | 32946 => "zip".into(),
-            32773 => "packbits".into(),
-            other => other.to_string(),
-        };
-        attributes.push(("compression".into(), name));
-    }
-    if dir0.orientation != 1 {
-        attributes.push(("Orientation".into(), dir0.orientation.to_string()));
-    }
-    attributes.sort();
-    let env = environment(texture_format.as_deref());
-    if let Some(kind) = env {
-        super::environment_map(
-            "TIFF",
-            kind,
-            &format!(
-                "textureformat \"{}\", {}x{}",
-                texture_format.as_deref().unwrap_or(""),
-                dir0.width,
-                dir0.height
-            ),
-            options,
-            &mut notes,
-        )?;
-    }
-    // Declared sizes of every level read, checked before decoding.
+    tl
+}
+
+/// The declared sizes of every level read, checked before decoding: no
+/// more directories than a mip chain of level 0 has, level 0 (twice, with
+/// the levels after it) within `limits`.
+fn check_levels(dir0: &Directory, count: usize, limits: &Limits) -> Result<()> {
     let full = crate::mip::level_count(dir0.width, dir0.height, Rounding::Down, None) as usize;
     let up = crate::mip::level_count(dir0.width, dir0.height, Rounding::Up, None) as usize;
     if count > full.max(up) {
@@ -718,77 +861,48 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
         (dir0.width as u64 * dir0.height as u64)
             .saturating_mul(texel)
             .saturating_mul(if count > 1 { 2 } else { 1 }),
-    )?;
-    if let Some(n) = dir0.alpha_note {
+    )
+}
+
+/// The rounding a mip chain's level 1 shows (`None` when its size is
+/// neither level 0 halved down nor up; the size check then refuses it).
+fn level_rounding(dir0: &Directory, dir1: &Directory) -> Option<Rounding> {
+    let up_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Up);
+    let down_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Down);
+    if (dir1.width, dir1.height) == down_size {
+        Some(Rounding::Down)
+    } else if (dir1.width, dir1.height) == up_size {
+        Some(Rounding::Up)
+    } else {
+        None
+    }
+}
+
+/// The TIFF `Orientation` (274) applied to every level, unless turned off;
+/// a note says which.
+fn apply_orientation(
+    levels: &mut [Texture],
+    orientation: u16,
+    options: &LoadOptions,
+    notes: &mut Vec<String>,
+) -> Result<()> {
+    if options.auto_orient {
+        for l in levels.iter_mut() {
+            *l = super::orient(l, orientation)?;
+        }
         notes.push(format!(
-            "{n} ({} straight or none overrides)",
-            Setting::Alpha
+            "TIFF orientation {} applied ({} keeps the stored order)",
+            orientation,
+            Setting::NoAutoOrient
+        ));
+    } else {
+        notes.push(format!(
+            "TIFF orientation {} not applied ({})",
+            orientation,
+            Setting::NoAutoOrient
         ));
     }
-    if let Some(map) = &dir0.palette
-        && map.iter().any(|&v| v % 257 != 0)
-    {
-        notes.push(
-            "palette TIFF: the colour map's 16-bit entries are rounded down to 8 bits, as \
-             OpenImageIO reads them"
-                .into(),
-        );
-    }
-    let mut levels = vec![r0.texture(&mut d, &dir0)?];
-    let mut rounding = Rounding::Down;
-    for (k, &fix) in fixes.iter().enumerate().take(count).skip(1) {
-        d.seek_to_image(k).map_err(|e| reader(k).err(e))?;
-        let rk = reader(k);
-        let dir = rk.directory(&mut d, fix)?;
-        if k == 1 {
-            let up_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Up);
-            let down_size = crate::mip::level_size(dir0.width, dir0.height, 1, Rounding::Down);
-            if (dir.width, dir.height) == down_size {
-                rounding = Rounding::Down;
-            } else if (dir.width, dir.height) == up_size {
-                rounding = Rounding::Up;
-            }
-        }
-        let want = crate::mip::level_size(dir0.width, dir0.height, k as u32, rounding);
-        if (dir.width, dir.height) != want || dir.format != dir0.format {
-            return Err(decode_err(format!(
-                "mip level {k} is {}x{} {}, level 0 implies {}x{} {}",
-                dir.width, dir.height, dir.format, want.0, want.1, dir0.format
-            )));
-        }
-        levels.push(rk.texture(&mut d, &dir)?);
-    }
-    if dir0.orientation != 1 {
-        if options.auto_orient {
-            for l in &mut levels {
-                *l = super::orient(l, dir0.orientation)?;
-            }
-            notes.push(format!(
-                "TIFF orientation {} applied ({} keeps the stored order)",
-                dir0.orientation,
-                Setting::NoAutoOrient
-            ));
-        } else {
-            notes.push(format!(
-                "TIFF orientation {} not applied ({})",
-                dir0.orientation,
-                Setting::NoAutoOrient
-            ));
-        }
-    }
-    let format = levels[0].format();
-    let mut info = SourceInfo::new(FileFormat::Tiff, &format);
-    info.own_mips = levels.len() > 1;
-    info.rounding = rounding;
-    info.wrap = super::recorded_wrap(wrap_text.as_deref(), &mut notes);
-    info.tile = dir0.tile;
-    info.attributes = attributes;
-    info.environment = env;
-    info.notes = notes;
-    // TIFF names no transfer parvo reads: its values are taken as they
-    // are (linear), as OpenImageIO reads them, and that is an assumption.
-    info.color_stated = false;
-    Ok(Loaded { levels, info })
+    Ok(())
 }
 
 /// TIFF in the container table (read only): strips and tiles, chunky and

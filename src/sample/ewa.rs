@@ -237,8 +237,29 @@ fn setup<P: Pixel>(
     let levels = &c.levels[..];
     let (w0, h0) = (levels[0].wf, levels[0].hf);
     // Derivative vectors in level-0 texels.
-    let (ax, ay) = (dx[0] * w0, dx[1] * h0);
-    let (bx, by) = (dy[0] * w0, dy[1] * h0);
+    let j = [dx[0] * w0, dx[1] * h0, dy[0] * w0, dy[1] * h0];
+    let (axes, hi, lo, delta) = lengthened_ellipse(j, o, lod.q);
+    let two = delta > 0.0 && lo != hi;
+    Setup {
+        levels: [
+            level_setup(c, hi, a, &axes, u, v),
+            level_setup(c, if two { lo } else { hi }, a, &axes, u, v),
+        ],
+        two,
+        delta,
+    }
+}
+
+/// Steps 1–3 of the module docs for derivative vectors `j = [ax, ay, bx,
+/// by]` in level-0 texels: the lengthened ellipse, and the levels read
+/// (`hi`, `lo`, the blend `delta`) in a chain whose last level is `last`.
+#[inline(always)]
+pub(crate) fn lengthened_ellipse(
+    j: [f64; 4],
+    o: &SamplerOptions,
+    last: usize,
+) -> (Axes, usize, usize, f32) {
+    let [ax, ay, bx, by] = j;
     // M = J·Jᵀ.
     let mss = ax * ax + bx * bx;
     let mst = ax * ay + bx * by;
@@ -270,7 +291,7 @@ fn setup<P: Pixel>(
     // log2(minor) = log2(minor²) / 2.
     let lambda = clamp_lod(0.5 * log2(minor2), o);
     let (hi, lo, delta) = if lambda > 0.0 {
-        levels_for(lambda, lod.q, o.mip)
+        levels_for(lambda, last, o.mip)
     } else {
         (0, 0, 0.0)
     };
@@ -280,14 +301,42 @@ fn setup<P: Pixel>(
         xy: (major2 - minor2) * exy,
         yy: major2 * eyy + minor2 * exx,
     };
-    let two = delta > 0.0 && lo != hi;
-    Setup {
-        levels: [
-            level_setup(c, hi, a, &axes, u, v),
-            level_setup(c, if two { lo } else { hi }, a, &axes, u, v),
-        ],
-        two,
-        delta,
+    (axes, hi, lo, delta)
+}
+
+/// One level's ellipse (step 4 of the module docs): `Σ = J'J'ᵀ + I` in
+/// the level's texels (per-axis scale `sx`, `sy` from level 0), shrunk to
+/// [`MAX_RADIUS`], and SPEC's `(A, B, C)/F`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Form {
+    /// `(Σss, Σst, Σtt)`.
+    pub sigma: (f64, f64, f64),
+    /// `(A, B, C)/F`: `r² = A·s² + B·s·t + C·t²`.
+    pub q: (f64, f64, f64),
+}
+
+/// The [`Form`] of `axes` on a level scaled by `(sx, sy)` from level 0.
+#[inline(always)]
+pub(crate) fn level_form(axes: &Axes, sx: f64, sy: f64) -> Form {
+    // J'·J'ᵀ in this level's texels; its trace is the sum of the squared
+    // semi-axes.
+    let (mut sxx, mut sxy, mut syy) = (axes.xx * sx * sx, axes.xy * sx * sy, axes.yy * sy * sy);
+    let size2 = sxx + syy;
+    if size2 > MAX_RADIUS * MAX_RADIUS {
+        let f = MAX_RADIUS * MAX_RADIUS / size2;
+        sxx *= f;
+        sxy *= f;
+        syy *= f;
+    }
+    // Σ = J'J'ᵀ + I (unit reconstruction variance).
+    let css = sxx + 1.0;
+    let cst = sxy;
+    let ctt = syy + 1.0;
+    // SPEC: A = Σtt, B = −2Σst, C = Σss, divided by F = AC − B²/4 = det Σ.
+    let inv_f = 1.0 / (css * ctt - cst * cst);
+    Form {
+        sigma: (css, cst, ctt),
+        q: (ctt * inv_f, -2.0 * cst * inv_f, css * inv_f),
     }
 }
 
@@ -310,7 +359,7 @@ fn read<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const VEC: b
 
 /// The (lengthened) ellipse in level-0 texels as the symmetric matrix
 /// `J'·J'ᵀ` whose square-root semi-axes it has.
-struct Axes {
+pub(crate) struct Axes {
     xx: f64,
     xy: f64,
     yy: f64,
@@ -363,22 +412,7 @@ fn level_setup<P: Pixel>(
         && l.h == 1
         && a.wrap.u != WrapMode::ClampToBorder
         && a.wrap.v != WrapMode::ClampToBorder;
-    // J'·J'ᵀ in this level's texels; its trace is the sum of the squared
-    // semi-axes.
-    let (mut sxx, mut sxy, mut syy) = (axes.xx * sx * sx, axes.xy * sx * sy, axes.yy * sy * sy);
-    let size2 = sxx + syy;
-    if size2 > MAX_RADIUS * MAX_RADIUS {
-        let f = MAX_RADIUS * MAX_RADIUS / size2;
-        sxx *= f;
-        sxy *= f;
-        syy *= f;
-    }
-    // Σ = J'J'ᵀ + I (unit reconstruction variance).
-    let css = sxx + 1.0;
-    let cst = sxy;
-    let ctt = syy + 1.0;
-    // SPEC: A = Σtt, B = −2Σst, C = Σss, divided by F = AC − B²/4 = det Σ.
-    let inv_f = 1.0 / (css * ctt - cst * cst);
+    let form = level_form(axes, sx, sy);
     // Centre in texel-centre coordinates, split into an integer base and
     // a fraction so huge coordinates keep their precision.
     let (ib, fs) = split(u * l.wf - 0.5);
@@ -386,8 +420,8 @@ fn level_setup<P: Pixel>(
     LevelSetup {
         k,
         single,
-        sigma: (css, cst, ctt),
-        q: (ctt * inv_f, -2.0 * cst * inv_f, css * inv_f),
+        sigma: form.sigma,
+        q: form.q,
         base: (ib, jb),
         frac: (fs as f64, ft as f64),
     }
@@ -410,12 +444,14 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
     let (qa, qb, qc) = ls.q;
     let (ib, jb) = ls.base;
     let (fs, ft) = ls.frac;
-    // Extent in t of the ellipse r² < 1 is sqrt(Σtt).
-    let t_ext = ctt.sqrt();
-    let t0 = -fast_floor(t_ext - ft);
-    let t1 = fast_floor(ft + t_ext);
     if EXACT {
-        return exact_rows(l, c, k, a, (qa, qb, qc), (ib, jb), (fs, ft), (t0, t1), sink);
+        let form = Form {
+            sigma: ls.sigma,
+            q: ls.q,
+        };
+        return exact_scan(&form, (ib, jb), (fs, ft), |x, y| {
+            l.fetch(&c.lut, k as u32, x, y, a, sink)
+        });
     }
     #[cfg(target_arch = "x86_64")]
     if VEC
@@ -691,19 +727,21 @@ fn run_sum<'a, P: Pixel + 'a, S: TexelSink, const FMA: bool>(
     )
 }
 
-/// The plain inner loops of [`ewa_exact`].
-#[allow(clippy::too_many_arguments)]
-fn exact_rows<P: Pixel, S: TexelSink>(
-    l: &super::fetch::Level<P>,
-    c: &Chain<P>,
-    k: usize,
-    a: &Addressing,
-    (qa, qb, qc): (f64, f64, f64),
+/// The plain inner loops of [`ewa_exact`]: every texel with `r² < 1`
+/// around the centre `base + frac` (texel-centre coordinates), read with
+/// `fetch(x, y)` and weighted `exp(−2r²) − exp(−2)`, summed in `f64`. The
+/// cube map's EWA reads its texels across face edges through `fetch`.
+pub(crate) fn exact_scan(
+    form: &Form,
     (ib, jb): (i64, i64),
     (fs, ft): (f64, f64),
-    (t0, t1): (i64, i64),
-    sink: &mut S,
+    mut fetch: impl FnMut(i64, i64) -> [f32; 4],
 ) -> [f32; 4] {
+    let (qa, qb, qc) = form.q;
+    // Extent in t of the ellipse r² < 1 is sqrt(Σtt).
+    let t_ext = form.sigma.2.sqrt();
+    let t0 = -fast_floor(t_ext - ft);
+    let t1 = fast_floor(ft + t_ext);
     let e_alpha = (-ALPHA).exp();
     let mut acc = [0.0f64; 4];
     let mut wsum = 0.0f64;
@@ -722,14 +760,7 @@ fn exact_rows<P: Pixel, S: TexelSink>(
             let r2 = qa * ss * ss + qb * ss * tt + qc * tt * tt;
             if r2 < 1.0 {
                 let w = (-ALPHA * r2).exp() - e_alpha;
-                let tex = l.fetch(
-                    &c.lut,
-                    k as u32,
-                    ib.saturating_add(is),
-                    jb.saturating_add(jt),
-                    a,
-                    sink,
-                );
+                let tex = fetch(ib.saturating_add(is), jb.saturating_add(jt));
                 for c in 0..4 {
                     acc[c] += w * tex[c] as f64;
                 }
@@ -742,6 +773,6 @@ fn exact_rows<P: Pixel, S: TexelSink>(
     } else {
         // Unreachable in exact arithmetic (the ellipse contains a texel
         // centre); kept so rounding can never divide by zero.
-        l.fetch(&c.lut, k as u32, ib, jb, a, sink)
+        fetch(ib, jb)
     }
 }

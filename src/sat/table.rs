@@ -282,131 +282,29 @@ impl<A: Accumulator> SummedAreaTable<A> {
     /// would exceed the f32 range is refused rather than storing infinities.
     pub fn build(tex: &Texture) -> Result<Self> {
         let (w, h, ch) = (tex.width() as usize, tex.height() as usize, tex.channels());
-        // The table is reserved first, so a size the machine cannot hold
-        // is an error before any other work (not an abort while filling:
-        // an 8-bit RGBA level above 4096² needs 8 times its bytes).
-        let entries = (w + 1).checked_mul(h + 1).and_then(|n| n.checked_mul(ch));
-        let mut data: Vec<A> = Vec::new();
-        if entries.is_none_or(|n| data.try_reserve_exact(n).is_err()) {
-            let bytes =
-                (w as f64 + 1.0) * (h as f64 + 1.0) * ch as f64 * std::mem::size_of::<A>() as f64;
-            return Err(Error::Limits(format!(
-                "a summed-area table of {w}x{h} with {ch} channels in {} entries needs \
-                 {:.1} GiB, which cannot be allocated",
-                A::KIND,
-                bytes / (1u64 << 30) as f64
-            )));
-        }
-        let fmt = tex.format();
+        let data = reserve::<A>(w, h, ch)?;
         let alpha = alpha_weighting(tex);
         let kind = A::KIND;
-        let (prep, unit) = if let Some(bits) = kind.integer_bits() {
-            let srgb = fmt.color_space == ColorSpace::Srgb && fmt.color_channels() > 0;
-            let src = match tex.texels() {
-                Texels::U8(v) if !srgb => Source::U8(v),
-                Texels::U16(v) if !srgb => Source::U16(v),
-                _ => {
-                    return Err(Error::InvalidOption(format!(
-                        "a {kind} summed-area table sums integer codes and needs linear \
-                         u8 or u16 data, not {fmt}; use an f64 or offset-f32 table"
-                    )));
-                }
-            };
-            let need = required_bits(value_bits(&fmt), tex.width(), tex.height());
-            if need > bits {
-                return Err(Error::InvalidOption(format!(
-                    "a {kind} summed-area table of {w}x{h} {} texels needs {need} bits \
-                     and would overflow; use {} or the automatic choice",
-                    fmt.channel_type,
-                    if need <= 64 { "u64" } else { "u128" }
-                )));
-            }
-            let unit = if fmt.channel_type == ChannelType::U8 {
-                255.0
-            } else {
-                65535.0
-            };
-            let prep = Prepared {
-                src,
-                w,
-                ch,
-                alpha,
-                offset: [0.0; 4],
-            };
-            (prep, unit)
-        } else {
-            let lin = match tex.texels() {
-                Texels::F32(v) if fmt.color_space == ColorSpace::Linear => Cow::Borrowed(&v[..]),
-                _ => Cow::Owned(tex.to_linear()),
-            };
-            let prep = Prepared {
-                src: Source::Linear(lin),
-                w,
-                ch,
-                alpha,
-                offset: [0.0; 4],
-            };
-            (prep, 1.0)
+        let (mut prep, unit) = match kind.integer_bits() {
+            Some(bits) => prepare_codes(tex, kind, bits, alpha)?,
+            None => (prepare_linear(tex, alpha), 1.0),
         };
-        let mut prep = prep;
-        let mut entry_error = 0.0;
-        let max_abs;
-        let mut sum_abs = [0.0; 4];
-        if !kind.is_integer() {
-            let (abs, sum) = prep.float_sums(h);
-            if abs.iter().any(|a| !a.is_finite()) {
-                // Only NaN or ±Inf input makes these sums non-finite (finite
-                // f32 sums stay below 2¹²⁸·2⁶⁴); find the first for the error.
-                first_non_finite(tex)?;
-                return Err(Error::InvalidOption(
-                    "finite texels decode to infinite linear values (sRGB beyond the f32 range)"
-                        .into(),
-                ));
-            }
-            sum_abs = abs;
-            if kind == AccumulatorKind::OffsetF32 {
-                let n = (w * h) as f64;
-                prep.offset = std::array::from_fn(|c| if c < ch { sum[c] / n } else { 0.0 });
-                // Entries now sum value − offset: recompute the |·| sums.
-                sum_abs = prep.float_sums(h).0;
-            }
-        }
-        let data = build_bands::<A>(&prep, w, h, ch, data);
-        if !kind.is_integer() {
-            // f64 entries cannot overflow (see above) and are not rounded
-            // again when stored: only f32 kinds need their largest entry.
-            let max_entry = if kind == AccumulatorKind::F64 {
-                0.0
-            } else {
-                data.par_iter()
-                    .map(|e| e.to_f64().abs())
-                    .reduce(|| 0.0, f64::max)
-            };
-            if max_entry.is_infinite() {
-                return Err(Error::InvalidOption(format!(
-                    "the sums of this texture exceed the {kind} range; use an f64 table"
-                )));
-            }
-            // Running sums in f64: each summand passes fewer than 2(w + h)
-            // additions (row run, band totals, band scan, column run; the
-            // γ bound); f32 entries add one rounding of the entry.
-            let u64 = f64::EPSILON / 2.0;
-            let store = if A::KIND == AccumulatorKind::F64 {
-                0.0
-            } else {
-                f32::EPSILON as f64 / 2.0
-            };
-            let total_abs = sum_abs.iter().fold(0.0f64, |m, &s| m.max(s));
-            entry_error =
-                2.0 * (w + h) as f64 * u64 * total_abs * (1.0 + store) + store * max_entry;
-            max_abs = max_entry.max(total_abs) + entry_error;
+        let sum_abs = if kind.is_integer() {
+            [0.0; 4]
         } else {
+            float_sums(&mut prep, tex, kind)?
+        };
+        let data = build_bands::<A>(&prep, w, h, ch, data);
+        let (entry_error, max_abs) = if kind.is_integer() {
             // Non-negative summands: the far corner holds each channel's
             // largest entry.
-            max_abs = data[data.len() - ch..]
+            let max_abs = data[data.len() - ch..]
                 .iter()
                 .fold(0.0f64, |m, e| m.max(e.to_f64()));
-        }
+            (0.0, max_abs)
+        } else {
+            float_error::<A>(&data, w, h, &sum_abs)?
+        };
         Ok(SummedAreaTable {
             width: tex.width(),
             height: tex.height(),
@@ -640,6 +538,150 @@ fn border_channels(b: [f32; 4], ch: usize) -> [f32; 4] {
         2 => [b[0], b[3], 0.0, 0.0],
         _ => b,
     }
+}
+
+/// The table's storage, reserved before any other work, so that a size
+/// the machine cannot hold is an error (not an abort while filling: an
+/// 8-bit RGBA level above 4096² needs 8 times its bytes).
+fn reserve<A: Accumulator>(w: usize, h: usize, ch: usize) -> Result<Vec<A>> {
+    let entries = (w + 1).checked_mul(h + 1).and_then(|n| n.checked_mul(ch));
+    let mut data: Vec<A> = Vec::new();
+    if entries.is_none_or(|n| data.try_reserve_exact(n).is_err()) {
+        let bytes =
+            (w as f64 + 1.0) * (h as f64 + 1.0) * ch as f64 * std::mem::size_of::<A>() as f64;
+        return Err(Error::Limits(format!(
+            "a summed-area table of {w}x{h} with {ch} channels in {} entries needs \
+             {:.1} GiB, which cannot be allocated",
+            A::KIND,
+            bytes / (1u64 << 30) as f64
+        )));
+    }
+    Ok(data)
+}
+
+/// The source of an integer table of `bits`-bit entries: the stored
+/// codes of linear u8 or u16 data, refused when SPEC's rule says the
+/// sums would overflow; with the unit of the codes (255 or 65535).
+fn prepare_codes<'a>(
+    tex: &'a Texture,
+    kind: AccumulatorKind,
+    bits: u32,
+    alpha: Option<usize>,
+) -> Result<(Prepared<'a>, f64)> {
+    let fmt = tex.format();
+    let (w, h) = (tex.width() as usize, tex.height() as usize);
+    let srgb = fmt.color_space == ColorSpace::Srgb && fmt.color_channels() > 0;
+    let src = match tex.texels() {
+        Texels::U8(v) if !srgb => Source::U8(v),
+        Texels::U16(v) if !srgb => Source::U16(v),
+        _ => {
+            return Err(Error::InvalidOption(format!(
+                "a {kind} summed-area table sums integer codes and needs linear \
+                 u8 or u16 data, not {fmt}; use an f64 or offset-f32 table"
+            )));
+        }
+    };
+    let need = required_bits(value_bits(&fmt), tex.width(), tex.height());
+    if need > bits {
+        return Err(Error::InvalidOption(format!(
+            "a {kind} summed-area table of {w}x{h} {} texels needs {need} bits \
+             and would overflow; use {} or the automatic choice",
+            fmt.channel_type,
+            if need <= 64 { "u64" } else { "u128" }
+        )));
+    }
+    let unit = if fmt.channel_type == ChannelType::U8 {
+        255.0
+    } else {
+        65535.0
+    };
+    let prep = Prepared {
+        src,
+        w,
+        ch: tex.channels(),
+        alpha,
+        offset: [0.0; 4],
+    };
+    Ok((prep, unit))
+}
+
+/// The source of a float table: linear-light values (the texels
+/// themselves when they are linear f32).
+fn prepare_linear(tex: &Texture, alpha: Option<usize>) -> Prepared<'_> {
+    let fmt = tex.format();
+    let lin = match tex.texels() {
+        Texels::F32(v) if fmt.color_space == ColorSpace::Linear => Cow::Borrowed(&v[..]),
+        _ => Cow::Owned(tex.to_linear()),
+    };
+    Prepared {
+        src: Source::Linear(lin),
+        w: tex.width() as usize,
+        ch: tex.channels(),
+        alpha,
+        offset: [0.0; 4],
+    }
+}
+
+/// Per-channel sums of `|summand|` of a float table's source, which
+/// bound its error; refuses NaN or infinite input. An offset-f32 table
+/// gets its per-channel offset (the mean) here, and the sums are of the
+/// offset summands.
+fn float_sums(prep: &mut Prepared<'_>, tex: &Texture, kind: AccumulatorKind) -> Result<[f64; 4]> {
+    let (w, h, ch) = (prep.w, tex.height() as usize, prep.ch);
+    let (abs, sum) = prep.float_sums(h);
+    if abs.iter().any(|a| !a.is_finite()) {
+        // Only NaN or ±Inf input makes these sums non-finite (finite
+        // f32 sums stay below 2¹²⁸·2⁶⁴); find the first for the error.
+        first_non_finite(tex)?;
+        return Err(Error::InvalidOption(
+            "finite texels decode to infinite linear values (sRGB beyond the f32 range)".into(),
+        ));
+    }
+    if kind != AccumulatorKind::OffsetF32 {
+        return Ok(abs);
+    }
+    let n = (w * h) as f64;
+    prep.offset = std::array::from_fn(|c| if c < ch { sum[c] / n } else { 0.0 });
+    // Entries now sum value − offset: recompute the |·| sums.
+    Ok(prep.float_sums(h).0)
+}
+
+/// A float table's bound on the error of each entry, and on |entry|
+/// (both in stored units), from its `w × h` level's sums of `|summand|`;
+/// an f32 table whose entries overflowed is refused.
+fn float_error<A: Accumulator>(
+    data: &[A],
+    w: usize,
+    h: usize,
+    sum_abs: &[f64; 4],
+) -> Result<(f64, f64)> {
+    let kind = A::KIND;
+    // f64 entries cannot overflow (see above) and are not rounded
+    // again when stored: only f32 kinds need their largest entry.
+    let max_entry = if kind == AccumulatorKind::F64 {
+        0.0
+    } else {
+        data.par_iter()
+            .map(|e| e.to_f64().abs())
+            .reduce(|| 0.0, f64::max)
+    };
+    if max_entry.is_infinite() {
+        return Err(Error::InvalidOption(format!(
+            "the sums of this texture exceed the {kind} range; use an f64 table"
+        )));
+    }
+    // Running sums in f64: each summand passes fewer than 2(w + h)
+    // additions (row run, band totals, band scan, column run; the
+    // γ bound); f32 entries add one rounding of the entry.
+    let u64 = f64::EPSILON / 2.0;
+    let store = if kind == AccumulatorKind::F64 {
+        0.0
+    } else {
+        f32::EPSILON as f64 / 2.0
+    };
+    let total_abs = sum_abs.iter().fold(0.0f64, |m, &s| m.max(s));
+    let entry_error = 2.0 * (w + h) as f64 * u64 * total_abs * (1.0 + store) + store * max_entry;
+    Ok((entry_error, max_entry.max(total_abs) + entry_error))
 }
 
 /// The parallel build: the level is cut into horizontal bands. Pass 1

@@ -608,110 +608,13 @@ impl Chain {
         let mut notes = Vec::new();
         let mut pointer_at = self.first_at;
         for (k, d) in self.dirs.iter().enumerate() {
-            let stored = d.entry(tag::PHOTOMETRIC).map(|e| e.inline_unsigned(l));
-            let stored_photometric = match stored {
-                None => None,
-                Some(Some(v)) => Some(v),
-                Some(None) => Some(u64::MAX),
-            };
-            let told = match stored_photometric {
-                // Palette indices are decoded as grey and mapped here.
-                Some(3) => Some(1),
-                Some(_) => None,
-                None => {
-                    // libtiff's and OpenImageIO's guess: grey for one
-                    // colour channel, RGB otherwise.
-                    let samples = d.unsigned(l, tag::SAMPLES_PER_PIXEL).unwrap_or(1);
-                    let extra = d.entry(tag::EXTRA_SAMPLES).map_or(0, |e| e.count);
-                    let rgb = samples.saturating_sub(extra) >= 3;
-                    notes.push(format!(
-                        "{}no PhotometricInterpretation tag: read as {}, as OpenImageIO does",
-                        if self.dirs.len() > 1 {
-                            format!("page {k}: ")
-                        } else {
-                            String::new()
-                        },
-                        match (rgb, samples) {
-                            (true, _) => "RGB",
-                            (false, 2) if extra == 0 => "two data channels (R, G)",
-                            _ => "grey (BlackIsZero)",
-                        }
-                    ));
-                    // The crate reads 1 and 2 samples as grey only.
-                    Some(if rgb { 2 } else { 1 })
-                }
-            };
-            // Old writers (libtiff's `quad-tile.tif`) store the tiles
-            // of a tiled image under the strip tags; libtiff reads them
-            // as tiles.
-            let tiles_as_strips = d.entry(tag::TILE_WIDTH).is_some()
-                && d.entry(tag::TILE_LENGTH).is_some()
-                && d.entry(tag::TILE_OFFSETS).is_none()
-                && d.entry(tag::TILE_BYTE_COUNTS).is_none()
-                && d.entry(tag::STRIP_OFFSETS).is_some()
-                && d.entry(tag::STRIP_BYTE_COUNTS).is_some();
-            // More BitsPerSample values than samples (Pillow's
-            // `tiff_wrong_bits_per_sample_2.tiff`): libtiff reads the
-            // first ones. Only done where the values stay out of line.
-            let samples = d.unsigned(l, tag::SAMPLES_PER_PIXEL).unwrap_or(1);
-            let bits_count = d.entry(tag::BITS_PER_SAMPLE).and_then(|e| {
-                let fits = Entry {
-                    count: samples,
-                    ..e.clone()
-                }
-                .byte_len()
-                .is_some_and(|n| n > l.offset_size());
-                (e.count > samples && fits).then_some(samples)
-            });
-            // RGB with one extra sample that is data (ExtraSamples 0,
-            // one value inline): the crate reads RGB only.
-            let rgb = matches!(stored_photometric.or(told.map(u64::from)), Some(2));
-            let extra_data = rgb
-                && samples == 4
-                && d.entry(tag::EXTRA_SAMPLES)
-                    .is_some_and(|e| e.count == 1 && e.inline_unsigned(l) == Some(0));
-            fixes.push(Fix {
-                stored_photometric,
-                told,
-                extra_data,
-            });
+            let fix = self.fix(k, d, &mut notes);
+            let rewrite = Rewrite::of(l, d);
+            fixes.push(fix);
             let last = k + 1 == self.dirs.len();
-            let next_at = if told.is_some() || tiles_as_strips || bits_count.is_some() || extra_data
-            {
-                let mut entries: Vec<Entry> = d
-                    .entries
-                    .iter()
-                    .filter(|e| told.is_none() || e.tag != tag::PHOTOMETRIC)
-                    .cloned()
-                    .collect();
-                if let Some(v) = told {
-                    entries.push(Entry::short(l, tag::PHOTOMETRIC, v));
-                }
-                if extra_data {
-                    for e in entries.iter_mut().filter(|e| e.tag == tag::EXTRA_SAMPLES) {
-                        *e = Entry::short(l, tag::EXTRA_SAMPLES, 2);
-                    }
-                }
-                if let Some(n) = bits_count {
-                    for e in entries.iter_mut().filter(|e| e.tag == tag::BITS_PER_SAMPLE) {
-                        e.count = n;
-                    }
-                }
-                if tiles_as_strips {
-                    for e in &mut entries {
-                        e.tag = match e.tag {
-                            tag::STRIP_OFFSETS => tag::TILE_OFFSETS,
-                            tag::STRIP_BYTE_COUNTS => tag::TILE_BYTE_COUNTS,
-                            t => t,
-                        };
-                    }
-                }
-                entries.sort_by_key(|e| e.tag);
-                let new = Dir {
-                    offset: 0,
-                    entries,
-                    next: if last && self.cut { 0 } else { d.next },
-                };
+            let next_at = if fix.told.is_some() || rewrite.needed() || fix.extra_data {
+                let next = if last && self.cut { 0 } else { d.next };
+                let new = rewritten(l, d, fix, rewrite, next);
                 let at = view.append_dir(l, &new)?;
                 view.write_at(pointer_at, &l.put_offset(at));
                 at + new.size(l) - l.offset_size()
@@ -724,6 +627,146 @@ impl Chain {
             pointer_at = next_at;
         }
         Ok((view, fixes, notes))
+    }
+
+    /// What directory `k` needs told to the decoder (see [`Fix`]); a
+    /// missing `PhotometricInterpretation` gets a note in `notes`.
+    fn fix(&self, k: usize, d: &Dir, notes: &mut Vec<String>) -> Fix {
+        let l = &self.layout;
+        let stored = d.entry(tag::PHOTOMETRIC).map(|e| e.inline_unsigned(l));
+        let stored_photometric = match stored {
+            None => None,
+            Some(Some(v)) => Some(v),
+            Some(None) => Some(u64::MAX),
+        };
+        let told = match stored_photometric {
+            // Palette indices are decoded as grey and mapped here.
+            Some(3) => Some(1),
+            Some(_) => None,
+            None => {
+                // libtiff's and OpenImageIO's guess: grey for one
+                // colour channel, RGB otherwise.
+                let samples = d.unsigned(l, tag::SAMPLES_PER_PIXEL).unwrap_or(1);
+                let extra = d.entry(tag::EXTRA_SAMPLES).map_or(0, |e| e.count);
+                let rgb = samples.saturating_sub(extra) >= 3;
+                notes.push(format!(
+                    "{}no PhotometricInterpretation tag: read as {}, as OpenImageIO does",
+                    if self.dirs.len() > 1 {
+                        format!("page {k}: ")
+                    } else {
+                        String::new()
+                    },
+                    match (rgb, samples) {
+                        (true, _) => "RGB",
+                        (false, 2) if extra == 0 => "two data channels (R, G)",
+                        _ => "grey (BlackIsZero)",
+                    }
+                ));
+                // The crate reads 1 and 2 samples as grey only.
+                Some(if rgb { 2 } else { 1 })
+            }
+        };
+        // RGB with one extra sample that is data (ExtraSamples 0,
+        // one value inline): the crate reads RGB only.
+        let samples = d.unsigned(l, tag::SAMPLES_PER_PIXEL).unwrap_or(1);
+        let rgb = matches!(stored_photometric.or(told.map(u64::from)), Some(2));
+        let extra_data = rgb
+            && samples == 4
+            && d.entry(tag::EXTRA_SAMPLES)
+                .is_some_and(|e| e.count == 1 && e.inline_unsigned(l) == Some(0));
+        Fix {
+            stored_photometric,
+            told,
+            extra_data,
+        }
+    }
+}
+
+/// What parvo changes in a directory's entries besides its [`Fix`], for
+/// files libtiff reads and the `tiff` crate alone would not.
+#[derive(Clone, Copy, Debug)]
+struct Rewrite {
+    /// The tiles of a tiled image are stored under the strip tags.
+    tiles_as_strips: bool,
+    /// `BitsPerSample` is cut to this many values (one per sample).
+    bits_count: Option<u64>,
+}
+
+impl Rewrite {
+    /// What directory `d` needs.
+    fn of(l: &Layout, d: &Dir) -> Rewrite {
+        // Old writers (libtiff's `quad-tile.tif`) store the tiles
+        // of a tiled image under the strip tags; libtiff reads them
+        // as tiles.
+        let tiles_as_strips = d.entry(tag::TILE_WIDTH).is_some()
+            && d.entry(tag::TILE_LENGTH).is_some()
+            && d.entry(tag::TILE_OFFSETS).is_none()
+            && d.entry(tag::TILE_BYTE_COUNTS).is_none()
+            && d.entry(tag::STRIP_OFFSETS).is_some()
+            && d.entry(tag::STRIP_BYTE_COUNTS).is_some();
+        // More BitsPerSample values than samples (Pillow's
+        // `tiff_wrong_bits_per_sample_2.tiff`): libtiff reads the
+        // first ones. Only done where the values stay out of line.
+        let samples = d.unsigned(l, tag::SAMPLES_PER_PIXEL).unwrap_or(1);
+        let bits_count = d.entry(tag::BITS_PER_SAMPLE).and_then(|e| {
+            let fits = Entry {
+                count: samples,
+                ..e.clone()
+            }
+            .byte_len()
+            .is_some_and(|n| n > l.offset_size());
+            (e.count > samples && fits).then_some(samples)
+        });
+        Rewrite {
+            tiles_as_strips,
+            bits_count,
+        }
+    }
+
+    /// Whether the entries change at all.
+    fn needed(self) -> bool {
+        self.tiles_as_strips || self.bits_count.is_some()
+    }
+}
+
+/// Directory `d` as the decoder is to read it: the photometric
+/// interpretation it is told, the data sample called unassociated alpha,
+/// `rewrite`'s changes, entries sorted by tag, `next` as the next pointer.
+fn rewritten(l: &Layout, d: &Dir, fix: Fix, rewrite: Rewrite, next: u64) -> Dir {
+    let told = fix.told;
+    let mut entries: Vec<Entry> = d
+        .entries
+        .iter()
+        .filter(|e| told.is_none() || e.tag != tag::PHOTOMETRIC)
+        .cloned()
+        .collect();
+    if let Some(v) = told {
+        entries.push(Entry::short(l, tag::PHOTOMETRIC, v));
+    }
+    if fix.extra_data {
+        for e in entries.iter_mut().filter(|e| e.tag == tag::EXTRA_SAMPLES) {
+            *e = Entry::short(l, tag::EXTRA_SAMPLES, 2);
+        }
+    }
+    if let Some(n) = rewrite.bits_count {
+        for e in entries.iter_mut().filter(|e| e.tag == tag::BITS_PER_SAMPLE) {
+            e.count = n;
+        }
+    }
+    if rewrite.tiles_as_strips {
+        for e in &mut entries {
+            e.tag = match e.tag {
+                tag::STRIP_OFFSETS => tag::TILE_OFFSETS,
+                tag::STRIP_BYTE_COUNTS => tag::TILE_BYTE_COUNTS,
+                t => t,
+            };
+        }
+    }
+    entries.sort_by_key(|e| e.tag);
+    Dir {
+        offset: 0,
+        entries,
+        next,
     }
 }
 

@@ -32,51 +32,8 @@ pub(super) fn words(
     limits: &Limits,
     dir: Option<&Directory>,
 ) -> Error {
-    use TiffFormatError as F;
-    use TiffUnsupportedError as U;
-    let corrupt = |what: String| decode_err(format!("{what}: the file is corrupt"));
     match e {
-        TiffError::LimitsExceeded => {
-            // A tag larger than the crate's fixed limit (only while the
-            // first directory is read, before parvo's limits apply)...
-            let big = raw.and_then(|r| {
-                r.entries
-                    .iter()
-                    .map(|e| (e, e.byte_len().unwrap_or(u64::MAX)))
-                    .find(|&(_, n)| n > CRATE_TAG_LIMIT)
-            });
-            if let Some((e, _)) = big
-                && !e.fits(l)
-            {
-                return corrupt(format!(
-                    "its {} tag claims {} values, more than the file holds",
-                    tag_name(e.tag),
-                    e.count
-                ));
-            }
-            if let Some(big) = big {
-                return Error::Limits(format!(
-                    "the {} tag holds {} values, more than the TIFF decoder's fixed limit of 1 MiB \
-                     for one tag (too many strips or tiles for it)",
-                    tag_name(big.0.tag),
-                    big.0.count
-                ));
-            }
-            // ... else a decoding buffer over the allocation limit.
-            match dir {
-                Some(d) => alloc_limit(
-                    limits,
-                    d,
-                    (d.width as u64 * d.height as u64)
-                        .saturating_mul(d.stored_samples as u64)
-                        .saturating_mul(d.bits.div_ceil(8) as u64),
-                ),
-                None => Error::Limits(
-                    "a strip, tile or tag of the file is larger than the allocation limit allows"
-                        .into(),
-                ),
-            }
-        }
+        TiffError::LimitsExceeded => limits_exceeded(raw, l, limits, dir),
         TiffError::IoError(io) => match io.kind() {
             std::io::ErrorKind::UnexpectedEof => {
                 decode_err("the file ends before the pixel data it declares (it is truncated)")
@@ -89,110 +46,175 @@ pub(super) fn words(
         TiffError::IntSizeError => {
             corrupt("a size or offset in the file is larger than this machine can address".into())
         }
-        TiffError::FormatError(f) => match f {
-            F::TiffSignatureNotFound | F::TiffSignatureInvalid => {
-                decode_err("not a TIFF file (its signature is wrong)")
-            }
-            F::ImageFileDirectoryNotFound => {
-                corrupt("a directory (page) the file points to is missing".into())
-            }
-            F::InconsistentSizesEncountered => corrupt(match raw {
-                Some(r) => sizes_disagree(r, l),
-                None => "its tags disagree about the layout of the image".into(),
-            }),
-            F::InvalidDimensions(w, h) => decode_err(format!(
-                "the image is {w}x{h}: a width or height of zero holds no image"
-            )),
-            F::InvalidTag => corrupt("a text tag is not valid text".into()),
-            F::InvalidTagValueType(t) => corrupt(format!(
-                "the {} tag has the wrong value type",
-                crate_tag_name(t)
-            )),
-            F::RequiredTagNotFound(t) => {
-                decode_err(format!("the required {} tag is missing", crate_tag_name(t)))
-            }
-            F::UnknownPredictor(p) => {
-                decode_err(format!("predictor {p} is not a TIFF predictor (1, 2 or 3)"))
-            }
-            F::UnknownPlanarConfiguration(c) => decode_err(format!(
-                "planar configuration {c} is neither 1 (contiguous) nor 2 (planar)"
-            )),
-            F::InvalidTypeForTag => corrupt(
-                match raw.and_then(|r| r.entries.iter().find(|e| e.byte_len().is_none())) {
-                    Some(e) => format!(
-                        "its {} tag has a value type TIFF does not define",
-                        tag_name(e.tag)
-                    ),
-                    None => "a tag has a value type TIFF does not define".into(),
-                },
-            ),
-            F::InvalidCountForTag(t, n) => corrupt(format!(
-                "the {} tag has {n} values, which does not fit the image",
-                crate_tag_name(t)
-            )),
-            F::StripTileTagConflict => corrupt(
-                "it has neither a complete pair of strip tags (StripOffsets, StripByteCounts) \
-                 nor of tile tags (TileOffsets, TileByteCounts)"
-                    .into(),
-            ),
-            F::CycleInOffsets => corrupt("its chain of directories loops".into()),
-            F::SamplesPerPixelIsZero => corrupt("SamplesPerPixel is 0".into()),
-            F::CompressedDataCorrupt(m) => compressed_corrupt(raw, l, &m),
-            other => corrupt(format!("its structure is invalid ({other})")),
-        },
-        TiffError::UnsupportedError(u) => decode_err(match u {
-            U::FloatingPointPredictor(_) | U::HorizontalPredictor(_) => format!(
-                "the {} predictor is not supported for samples of this depth",
-                if matches!(u, U::FloatingPointPredictor(_)) {
-                    "floating-point"
-                } else {
-                    "horizontal"
-                }
-            ),
-            U::InconsistentBitsPerSample(b) => {
-                let b: Vec<u16> = b.iter().map(|&x| x as u16).collect();
-                format!(
-                    "channels of different bit depths ({}) are not supported",
-                    join(&b)
-                )
-            }
-            U::InterpretationWithBits(_, b) => format!(
-                "this photometric interpretation with {} bits per sample is not supported",
-                b.first().copied().unwrap_or(0)
-            ),
-            U::UnknownInterpretation => match raw.and_then(|r| r.unsigned(l, tag::PHOTOMETRIC)) {
-                Some(32844) => "LogL (SGI) TIFF is not supported".into(),
-                Some(32845) => "LogLuv (SGI) TIFF is not supported".into(),
-                Some(p) => format!("photometric interpretation {p} is not supported"),
-                None => "its PhotometricInterpretation tag does not hold one number".into(),
-            },
-            U::UnknownCompressionMethod => "its compression method is unknown".into(),
-            U::UnsupportedCompressionMethod(m) => format!(
-                "{} is not supported (parvo reads uncompressed, LZW, Deflate/ZIP, PackBits, JPEG \
-                 and CCITT Group 4 TIFF)",
-                compression_name(m.to_u16())
-            ),
-            U::UnsupportedSampleDepth(b) | U::UnsupportedBitsPerChannel(b) => {
-                format!("{b}-bit samples are not supported")
-            }
-            U::UnsupportedSampleFormat(_) => "this sample format is not supported".into(),
-            U::UnsupportedColorType(_) => {
-                "this combination of channels and bit depth is not supported".into()
-            }
-            U::UnsupportedPlanarConfig(_) => "this planar configuration is not supported".into(),
-            U::UnsupportedDataType => "a tag's data type is not supported".into(),
-            U::UnsupportedInterpretation(_) => {
-                "this photometric interpretation is not supported".into()
-            }
-            U::ChromaSubsampling => "subsampled YCbCr is not supported".into(),
-            U::MisalignedTileBoundaries => {
-                "tiles whose rows do not end on a byte are not supported".into()
-            }
-            other => format!("{other}"),
-        }),
+        TiffError::FormatError(f) => format_error(f, raw, l),
+        TiffError::UnsupportedError(u) => decode_err(unsupported(u, raw, l)),
         TiffError::UsageError(_) => {
             corrupt("its strip or tile tables do not match the image".into())
         }
+    }
+}
+
+/// `what`, said to make the file corrupt.
+fn corrupt(what: String) -> Error {
+    decode_err(format!("{what}: the file is corrupt"))
+}
+
+/// The crate's "limits exceeded": a tag larger than its fixed limit, or a
+/// decoding buffer over the allocation limit.
+fn limits_exceeded(
+    raw: Option<&chain::Dir>,
+    l: &chain::Layout,
+    limits: &Limits,
+    dir: Option<&Directory>,
+) -> Error {
+    // A tag larger than the crate's fixed limit (only while the
+    // first directory is read, before parvo's limits apply)...
+    let big = raw.and_then(|r| {
+        r.entries
+            .iter()
+            .map(|e| (e, e.byte_len().unwrap_or(u64::MAX)))
+            .find(|&(_, n)| n > CRATE_TAG_LIMIT)
+    });
+    if let Some((e, _)) = big
+        && !e.fits(l)
+    {
+        return corrupt(format!(
+            "its {} tag claims {} values, more than the file holds",
+            tag_name(e.tag),
+            e.count
+        ));
+    }
+    if let Some(big) = big {
+        return Error::Limits(format!(
+            "the {} tag holds {} values, more than the TIFF decoder's fixed limit of 1 MiB \
+             for one tag (too many strips or tiles for it)",
+            tag_name(big.0.tag),
+            big.0.count
+        ));
+    }
+    // ... else a decoding buffer over the allocation limit.
+    match dir {
+        Some(d) => alloc_limit(
+            limits,
+            d,
+            (d.width as u64 * d.height as u64)
+                .saturating_mul(d.stored_samples as u64)
+                .saturating_mul(d.bits.div_ceil(8) as u64),
+        ),
+        None => Error::Limits(
+            "a strip, tile or tag of the file is larger than the allocation limit allows".into(),
+        ),
+    }
+}
+
+/// A malformed file (the crate's `TiffFormatError`) in words.
+fn format_error(f: TiffFormatError, raw: Option<&chain::Dir>, l: &chain::Layout) -> Error {
+    use TiffFormatError as F;
+    match f {
+        F::TiffSignatureNotFound | F::TiffSignatureInvalid => {
+            decode_err("not a TIFF file (its signature is wrong)")
+        }
+        F::ImageFileDirectoryNotFound => {
+            corrupt("a directory (page) the file points to is missing".into())
+        }
+        F::InconsistentSizesEncountered => corrupt(match raw {
+            Some(r) => sizes_disagree(r, l),
+            None => "its tags disagree about the layout of the image".into(),
+        }),
+        F::InvalidDimensions(w, h) => decode_err(format!(
+            "the image is {w}x{h}: a width or height of zero holds no image"
+        )),
+        F::InvalidTag => corrupt("a text tag is not valid text".into()),
+        F::InvalidTagValueType(t) => corrupt(format!(
+            "the {} tag has the wrong value type",
+            crate_tag_name(t)
+        )),
+        F::RequiredTagNotFound(t) => {
+            decode_err(format!("the required {} tag is missing", crate_tag_name(t)))
+        }
+        F::UnknownPredictor(p) => {
+            decode_err(format!("predictor {p} is not a TIFF predictor (1, 2 or 3)"))
+        }
+        F::UnknownPlanarConfiguration(c) => decode_err(format!(
+            "planar configuration {c} is neither 1 (contiguous) nor 2 (planar)"
+        )),
+        F::InvalidTypeForTag => corrupt(
+            match raw.and_then(|r| r.entries.iter().find(|e| e.byte_len().is_none())) {
+                Some(e) => format!(
+                    "its {} tag has a value type TIFF does not define",
+                    tag_name(e.tag)
+                ),
+                None => "a tag has a value type TIFF does not define".into(),
+            },
+        ),
+        F::InvalidCountForTag(t, n) => corrupt(format!(
+            "the {} tag has {n} values, which does not fit the image",
+            crate_tag_name(t)
+        )),
+        F::StripTileTagConflict => corrupt(
+            "it has neither a complete pair of strip tags (StripOffsets, StripByteCounts) \
+         nor of tile tags (TileOffsets, TileByteCounts)"
+                .into(),
+        ),
+        F::CycleInOffsets => corrupt("its chain of directories loops".into()),
+        F::SamplesPerPixelIsZero => corrupt("SamplesPerPixel is 0".into()),
+        F::CompressedDataCorrupt(m) => compressed_corrupt(raw, l, &m),
+        other => corrupt(format!("its structure is invalid ({other})")),
+    }
+}
+
+/// What the crate does not read (its `TiffUnsupportedError`), in words.
+fn unsupported(u: TiffUnsupportedError, raw: Option<&chain::Dir>, l: &chain::Layout) -> String {
+    use TiffUnsupportedError as U;
+    match u {
+        U::FloatingPointPredictor(_) | U::HorizontalPredictor(_) => format!(
+            "the {} predictor is not supported for samples of this depth",
+            if matches!(u, U::FloatingPointPredictor(_)) {
+                "floating-point"
+            } else {
+                "horizontal"
+            }
+        ),
+        U::InconsistentBitsPerSample(b) => {
+            let b: Vec<u16> = b.iter().map(|&x| x as u16).collect();
+            format!(
+                "channels of different bit depths ({}) are not supported",
+                join(&b)
+            )
+        }
+        U::InterpretationWithBits(_, b) => format!(
+            "this photometric interpretation with {} bits per sample is not supported",
+            b.first().copied().unwrap_or(0)
+        ),
+        U::UnknownInterpretation => match raw.and_then(|r| r.unsigned(l, tag::PHOTOMETRIC)) {
+            Some(32844) => "LogL (SGI) TIFF is not supported".into(),
+            Some(32845) => "LogLuv (SGI) TIFF is not supported".into(),
+            Some(p) => format!("photometric interpretation {p} is not supported"),
+            None => "its PhotometricInterpretation tag does not hold one number".into(),
+        },
+        U::UnknownCompressionMethod => "its compression method is unknown".into(),
+        U::UnsupportedCompressionMethod(m) => format!(
+            "{} is not supported (parvo reads uncompressed, LZW, Deflate/ZIP, PackBits, JPEG \
+         and CCITT Group 4 TIFF)",
+            compression_name(m.to_u16())
+        ),
+        U::UnsupportedSampleDepth(b) | U::UnsupportedBitsPerChannel(b) => {
+            format!("{b}-bit samples are not supported")
+        }
+        U::UnsupportedSampleFormat(_) => "this sample format is not supported".into(),
+        U::UnsupportedColorType(_) => {
+            "this combination of channels and bit depth is not supported".into()
+        }
+        U::UnsupportedPlanarConfig(_) => "this planar configuration is not supported".into(),
+        U::UnsupportedDataType => "a tag's data type is not supported".into(),
+        U::UnsupportedInterpretation(_) => {
+            "this photometric interpretation is not supported".into()
+        }
+        U::ChromaSubsampling => "subsampled YCbCr is not supported".into(),
+        U::MisalignedTileBoundaries => {
+            "tiles whose rows do not end on a byte are not supported".into()
+        }
+        other => format!("{other}"),
     }
 }
 

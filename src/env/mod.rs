@@ -1,0 +1,206 @@
+//! Environment maps, cube maps and texture arrays: textures looked up by
+//! a direction (or a layer index) instead of a 2-D coordinate.
+//!
+//! - [`Kind`]: what a file's image is — a 2-D texture, an array of them, a
+//!   cube map, an array of cube maps, or a 2-D image that is a lat-long
+//!   environment.
+//! - [`cube`]: face selection, face coordinates and their derivatives as
+//!   the GL and Vulkan specifications define them, and [`CubeSampler`],
+//!   every filter of [`crate::sample`] read seamlessly across face edges.
+//! - [`latlong`]: [`LatLongSampler`], lookups of an equirectangular map
+//!   as OpenImageIO's `TextureSystem::environment()` does them.
+//! - [`prefilter`]: prefiltered specular levels (GGX, Beckmann, Phong
+//!   lobes, the split-sum convention) and diffuse irradiance (and SH9).
+//! - [`ArraySampler`]: a 2-D sampler per layer, the layer picked as GL
+//!   picks it.
+//!
+//! A direction lookup is a [`DirQuery`]: the direction (any length) and its
+//! change per pixel along screen x and y.
+
+pub mod cube;
+mod cube_ewa;
+pub mod latlong;
+pub mod prefilter;
+
+pub use cube::CubeSampler;
+pub use latlong::LatLongSampler;
+
+use crate::error::{Error, Result};
+use crate::mip::MipChain;
+use crate::sample::{Query, Sampler, SamplerOptions};
+
+/// What kind of image a texture is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Kind {
+    /// One 2-D image (with its mip levels).
+    #[default]
+    Plain,
+    /// `layers` 2-D images of one size and format.
+    Array {
+        /// Layer count (at least 1).
+        layers: u32,
+    },
+    /// Six square faces, in the order +X, −X, +Y, −Y, +Z, −Z.
+    Cube,
+    /// `cubes` cube maps (6 × `cubes` faces, cube by cube).
+    CubeArray {
+        /// Cube count (at least 1).
+        cubes: u32,
+    },
+    /// A 2-D image holding the sphere of directions in latitude and
+    /// longitude (equirectangular), OpenImageIO's `LatLong Environment`.
+    LatLong,
+}
+
+impl Kind {
+    /// How many 2-D images (faces or layers, each with its own mip chain)
+    /// a texture of this kind holds.
+    pub fn images(self) -> usize {
+        match self {
+            Kind::Plain | Kind::LatLong => 1,
+            Kind::Array { layers } => layers as usize,
+            Kind::Cube => 6,
+            Kind::CubeArray { cubes } => 6 * cubes as usize,
+        }
+    }
+
+    /// True for a cube map or an array of them.
+    pub fn is_cube(self) -> bool {
+        matches!(self, Kind::Cube | Kind::CubeArray { .. })
+    }
+
+    /// A short description, as `parvo info` prints it.
+    pub fn describe(self) -> String {
+        match self {
+            Kind::Plain => "2-D".into(),
+            Kind::Array { layers } => format!("2-D array, {layers} layers"),
+            Kind::Cube => "cube map (+x -x +y -y +z -z)".into(),
+            Kind::CubeArray { cubes } => format!("cube map array, {cubes} cubes"),
+            Kind::LatLong => "lat-long environment".into(),
+        }
+    }
+}
+
+/// A lookup by direction: the direction (any non-zero length) and its
+/// change per pixel along screen x (`ddx`) and y (`ddy`), as a shader
+/// gets them with `dFdx`/`dFdy` of the reflection vector.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct DirQuery {
+    /// Direction (x, y, z).
+    pub dir: [f32; 3],
+    /// ∂dir/∂x.
+    pub ddx: [f32; 3],
+    /// ∂dir/∂y.
+    pub ddy: [f32; 3],
+}
+
+impl DirQuery {
+    /// A query from its nine numbers, in the CLI's order
+    /// (`x y z dxdx dydx dzdx dxdy dydy dzdy`).
+    pub const fn new(dir: [f32; 3], ddx: [f32; 3], ddy: [f32; 3]) -> Self {
+        DirQuery { dir, ddx, ddy }
+    }
+
+    /// A point lookup: zero derivatives.
+    pub const fn point(dir: [f32; 3]) -> Self {
+        DirQuery {
+            dir,
+            ddx: [0.0; 3],
+            ddy: [0.0; 3],
+        }
+    }
+}
+
+/// The supersampled reference by direction, shared by the cube and
+/// lat-long samplers: the mean of `lookup` at `n × n` directions over the
+/// footprint `dir ± ddx/2 ± ddy/2`, one at the centre of each cell of the
+/// 2-D reference's grid (summed in `f64`).
+pub(crate) fn grid_average(
+    q: &DirQuery,
+    n: u32,
+    mut lookup: impl FnMut([f64; 3]) -> [f32; 4],
+) -> [f32; 4] {
+    let n = n.clamp(1, 64);
+    let inv = 1.0 / n as f64;
+    let (d, dx, dy) = (
+        q.dir.map(f64::from),
+        q.ddx.map(f64::from),
+        q.ddy.map(f64::from),
+    );
+    let mut acc = [0.0f64; 4];
+    for j in 0..n {
+        let ty = (j as f64 + 0.5) * inv - 0.5;
+        for i in 0..n {
+            let tx = (i as f64 + 0.5) * inv - 0.5;
+            let v = lookup(std::array::from_fn(|c| d[c] + tx * dx[c] + ty * dy[c]));
+            for c in 0..4 {
+                acc[c] += v[c] as f64;
+            }
+        }
+    }
+    let s = 1.0 / (n * n) as f64;
+    acc.map(|x| (x * s) as f32)
+}
+
+/// A 2-D texture array: one sampler per layer, sharing options.
+#[derive(Clone, Debug)]
+pub struct ArraySampler {
+    layers: Vec<Sampler>,
+}
+
+impl ArraySampler {
+    /// Samplers over `layers` (at least one; all of one size and format).
+    pub fn new(layers: &[MipChain], options: SamplerOptions) -> Result<Self> {
+        let first = layers
+            .first()
+            .ok_or_else(|| Error::InvalidOption("a texture array needs a layer".into()))?;
+        let l0 = &first.levels()[0];
+        for (i, l) in layers.iter().enumerate() {
+            let t = &l.levels()[0];
+            if (t.width(), t.height(), t.format(), l.len())
+                != (l0.width(), l0.height(), l0.format(), first.len())
+            {
+                return Err(Error::InvalidOption(format!(
+                    "array layer {i} ({}x{}, {} levels) differs from layer 0 ({}x{}, {} levels) in size, format or level count",
+                    t.width(),
+                    t.height(),
+                    l.len(),
+                    l0.width(),
+                    l0.height(),
+                    first.len()
+                )));
+            }
+        }
+        let layers = layers
+            .iter()
+            .map(|c| Sampler::new(c, options))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(ArraySampler { layers })
+    }
+
+    /// Number of layers.
+    pub fn layers(&self) -> usize {
+        self.layers.len()
+    }
+
+    /// The layer GL reads for array coordinate `layer`:
+    /// `clamp(floor(layer + 0.5), 0, layers − 1)` (NaN reads layer 0).
+    pub fn layer_index(&self, layer: f32) -> usize {
+        let l = (layer as f64 + 0.5).floor();
+        if l.is_nan() {
+            return 0;
+        }
+        l.clamp(0.0, (self.layers.len() - 1) as f64) as usize
+    }
+
+    /// Filtered linear RGBA of layer `layer` (see [`Self::layer_index`]).
+    pub fn sample(&self, q: &Query, layer: f32) -> [f32; 4] {
+        self.layers[self.layer_index(layer)].sample(q)
+    }
+
+    /// The sampler of one layer (for the other lookups: level, bias,
+    /// gather, compare, load).
+    pub fn layer(&self, layer: usize) -> Option<&Sampler> {
+        self.layers.get(layer)
+    }
+}
