@@ -218,15 +218,82 @@ impl Layout {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ChainLayout {
     layout: Layout,
+    /// [`Layout::offset`] as [`ChainLayout::address`] computes it.
+    fast: Fast,
     /// Bytes of one access: a texel, or a block.
     texel: u64,
     /// log2 of the block side in texels: 0 for texels, 2 for 4×4 blocks.
     block_shift: u32,
     /// Per level: width, height, base address.
     levels: Vec<(u32, u32, u64)>,
+    /// Per level: the width in units of the layout's row-major grid (texels
+    /// for `linear`, tiles for `tiled` and `morton:WxH`, super-tiles for
+    /// `blocked`).
+    rows: Vec<u64>,
     /// Summed-area table: entries per row, entry bytes, base address.
     sat: Option<(u64, u64, u64)>,
     total: u64,
+}
+
+/// [`Layout::offset`] with the tile sides as shifts when they are powers
+/// of two (the tiles GPUs use): the same offsets without a division per
+/// texel (`tests/cache_fast_paths.rs` compares them for every texel of
+/// odd-sized chains). Other sides use [`Layout::offset`] itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Fast {
+    Linear,
+    Morton,
+    /// Tiles of 2^bx × 2^by, row-major (or Z-order) inside.
+    Tiled {
+        bx: u32,
+        by: u32,
+        morton: bool,
+    },
+    /// Tiles of 2^tx × 2^ty in super-tiles of 2^sx × 2^sy.
+    Blocked {
+        tx: u32,
+        ty: u32,
+        sx: u32,
+        sy: u32,
+    },
+    Plain,
+}
+
+impl Fast {
+    fn of(layout: Layout) -> Self {
+        let p2 = |v: &[u32]| v.iter().all(|n| n.is_power_of_two());
+        let lg = u32::trailing_zeros;
+        match layout {
+            Layout::Linear => Fast::Linear,
+            Layout::Morton => Fast::Morton,
+            Layout::Tiled { tw, th } if p2(&[tw, th]) => Fast::Tiled {
+                bx: lg(tw),
+                by: lg(th),
+                morton: false,
+            },
+            Layout::MortonTiled { tw, th } => Fast::Tiled {
+                bx: lg(tw),
+                by: lg(th),
+                morton: true,
+            },
+            Layout::Blocked { tw, th, sw, sh } if p2(&[tw, th, sw, sh]) => Fast::Blocked {
+                tx: lg(tw),
+                ty: lg(th),
+                sx: lg(sw),
+                sy: lg(sh),
+            },
+            _ => Fast::Plain,
+        }
+    }
+
+    /// Units per row of a level `w` texels wide.
+    fn row(layout: Layout, w: u32) -> u64 {
+        match layout {
+            Layout::Linear | Layout::Morton => w as u64,
+            Layout::Tiled { tw, .. } | Layout::MortonTiled { tw, .. } => w.div_ceil(tw) as u64,
+            Layout::Blocked { sw, .. } => w.div_ceil(sw) as u64,
+        }
+    }
 }
 
 impl ChainLayout {
@@ -241,8 +308,10 @@ impl ChainLayout {
         }
         ChainLayout {
             layout,
+            fast: Fast::of(layout),
             texel: texel_bytes,
             block_shift: 0,
+            rows: sizes.iter().map(|&(w, _)| Fast::row(layout, w)).collect(),
             levels,
             sat: None,
             total: at,
@@ -367,11 +436,96 @@ impl ChainLayout {
     }
 
     /// Byte address of texel `(x, y)` of level `level` (in range).
-    #[inline]
+    #[inline(always)]
     pub fn address(&self, level: u32, x: u32, y: u32) -> u64 {
+        let k = level as usize;
+        let (w, _, base) = self.levels[k];
+        let row = self.rows[k];
+        let (x, y) = (x >> self.block_shift, y >> self.block_shift);
+        let offset = match self.fast {
+            Fast::Linear => y as u64 * w as u64 + x as u64,
+            Fast::Morton => interleave(x, y),
+            Fast::Tiled {
+                bx,
+                by,
+                morton: false,
+            } => {
+                let tile = ((y >> by) as u64 * row + (x >> bx) as u64) << (bx + by);
+                let (mx, my) = ((1u32 << bx) - 1, (1u32 << by) - 1);
+                tile + ((((y & my) << bx) | (x & mx)) as u64)
+            }
+            Fast::Tiled {
+                bx,
+                by,
+                morton: true,
+            } => {
+                let tile = ((y >> by) as u64 * row + (x >> bx) as u64) << (bx + by);
+                let (mx, my) = ((1u32 << bx) - 1, (1u32 << by) - 1);
+                tile + morton_in_tile(x & mx, y & my, 1 << bx, 1 << by)
+            }
+            Fast::Blocked { tx, ty, sx, sy } => {
+                let start = ((y >> sy) as u64 * row + (x >> sx) as u64) << (sx + sy);
+                let (xs, ys) = (x & ((1u32 << sx) - 1), y & ((1u32 << sy) - 1));
+                let inner = ((ys >> ty) << (sx - tx)) + (xs >> tx);
+                let (mx, my) = ((1u32 << tx) - 1, (1u32 << ty) - 1);
+                start + ((inner as u64) << (tx + ty)) + ((((ys & my) << tx) | (xs & mx)) as u64)
+            }
+            Fast::Plain => self.plain_offset(w, x, y),
+        };
+        base + offset * self.texel
+    }
+
+    /// [`Layout::offset`], out of line: tile sides that are not powers of
+    /// two are rare, and the shifted paths stay small where they are
+    /// inlined.
+    #[cold]
+    #[inline(never)]
+    fn plain_offset(&self, w: u32, x: u32, y: u32) -> u64 {
+        self.layout.offset(w, x, y)
+    }
+
+    /// The address of texel `(x, y)` of level `level` and the byte steps
+    /// to `(x + 1, y)` and `(x, y + 1)`, when the 2×2 block at `(x, y)`
+    /// (inside the level) is laid out so: row-major levels, and tiles of
+    /// power-of-two sides when the block is inside one tile. `None`
+    /// otherwise (take [`ChainLayout::address`] per texel). The four
+    /// addresses grow in the block's read order, so the first and the last
+    /// tell whether all four share a cache line.
+    #[inline(always)]
+    pub fn block_steps(&self, level: u32, x: u32, y: u32) -> Option<(u64, u64, u64)> {
+        if self.block_shift != 0 {
+            return None;
+        }
+        let t = self.texel;
+        match self.fast {
+            Fast::Linear => {
+                let (w, _, base) = self.levels[level as usize];
+                Some((base + (y as u64 * w as u64 + x as u64) * t, t, w as u64 * t))
+            }
+            Fast::Tiled {
+                bx,
+                by,
+                morton: false,
+            } if (!x & ((1 << bx) - 1)) != 0 && (!y & ((1 << by) - 1)) != 0 => {
+                Some((self.address(level, x, y), t, t << bx))
+            }
+            _ => None,
+        }
+    }
+
+    /// [`ChainLayout::address`] by [`Layout::offset`], the formula as
+    /// SPEC.md states it (the reference the address is tested against).
+    pub fn address_plain(&self, level: u32, x: u32, y: u32) -> u64 {
         let (w, _, base) = self.levels[level as usize];
         let (x, y) = (x >> self.block_shift, y >> self.block_shift);
         base + self.layout.offset(w, x, y) * self.texel
+    }
+
+    /// Width and height of level `k` in the layout's units (texels, or
+    /// 4×4 blocks).
+    pub fn level_size(&self, k: usize) -> (u32, u32) {
+        let (w, h, _) = self.levels[k];
+        (w, h)
     }
 
     /// Byte address of summed-area table entry `(x, y)` (0 ≤ x ≤ w,

@@ -8,12 +8,19 @@
 //! texel it reads to a [`crate::sample::TexelSink`]; [`run::AddressSink`] maps
 //! (level, x, y) to a byte address with a [`layout::ChainLayout`] and feeds
 //! the [`sim::Simulator`] (or records the addresses as a trace); [`run`]
-//! drives a whole frame, [`sweep`] one frame under a grid of caches,
-//! layouts and filters.
+//! drives a whole frame (pixel by pixel, or by 2×2 quads whose requests to
+//! one line merge), [`sweep`] one frame under a grid of caches, layouts and
+//! filters, [`prefetch`] times the cache's misses in a prefetching texture
+//! unit. [`shape`] stands in for a texture whose values no filter reads:
+//! sizes and format only, no texel generated; [`isotropic`] reports what
+//! an isotropic lookup reads without reading it.
 
+pub mod isotropic;
 pub mod layout;
+pub mod prefetch;
 pub mod reference;
 pub mod run;
+pub mod shape;
 pub mod sim;
 pub mod sweep;
 

@@ -13,11 +13,13 @@ use std::io::{BufRead, Write};
 
 use rayon::prelude::*;
 
+use super::isotropic::{AddressOnly, BlockSink};
 use super::layout::ChainLayout;
-use super::sim::{AddressSpace, CacheConfig, Simulator, Stats};
+use super::prefetch::{Prefetch, PrefetchStats, Timing};
+use super::sim::{AddressSpace, CacheConfig, Outcome, Simulator, Stats};
 use crate::error::{Error, Result};
 use crate::sample::{Query, Sampler, TexelSink};
-use crate::scene::{Frame, RasterOrder, Scene};
+use crate::scene::{Frame, RasterOrder, Scene, View};
 
 /// The level tag of a summed-area-table entry read.
 pub const SAT_LEVEL: u32 = 255;
@@ -73,6 +75,116 @@ impl TexelSink for AddressSink<'_> {
     }
 }
 
+/// The recording sink of a traced frame: each read's address in every
+/// layout (a sweep traces its frame once for all of them), and, when
+/// `merge` is set, consecutive reads of one line (lines of `1 << merge`
+/// bytes) at one level kept as one entry with a count: the simulator then
+/// takes the repeats as the hits they are without looking them up.
+/// `ONE` is the common case of one layout, compiled without the loop.
+struct Recorder<'a, const ONE: bool> {
+    layouts: &'a [&'a ChainLayout],
+    merge: Option<u32>,
+    out: Vec<Vec<u64>>,
+    counts: Vec<Vec<u32>>,
+}
+
+impl<'a, const ONE: bool> Recorder<'a, ONE> {
+    fn new(layouts: &'a [&'a ChainLayout], merge: Option<u32>, reserve: usize) -> Self {
+        let n = layouts.len();
+        Recorder {
+            layouts,
+            merge,
+            out: (0..n).map(|_| Vec::with_capacity(reserve)).collect(),
+            counts: (0..n)
+                .map(|_| Vec::with_capacity(if merge.is_some() { reserve } else { 0 }))
+                .collect(),
+        }
+    }
+
+    #[inline(always)]
+    fn put(&mut self, i: usize, a: u64, mergeable: bool) {
+        let out = &mut self.out[i];
+        if let Some(shift) = self.merge {
+            let counts = &mut self.counts[i];
+            if let (true, Some(&last), Some(n)) = (mergeable, out.last(), counts.last_mut())
+                && last >> shift == a >> shift
+            {
+                *n += 1;
+                return;
+            }
+            counts.push(1);
+        }
+        out.push(a);
+    }
+
+    /// Reads recorded so far (without merging).
+    fn len(&self) -> usize {
+        self.out.first().map_or(0, Vec::len)
+    }
+}
+
+impl<const ONE: bool> BlockSink for Recorder<'_, ONE> {
+    /// With one layout that lays the block out by steps, two addresses
+    /// (the first and the last) when the block fits one merged line: one
+    /// entry for four reads.
+    #[inline(always)]
+    fn block(&mut self, level: u32, x: u32, y: u32) {
+        if ONE && let Some((a, dx, dy)) = self.layouts[0].block_steps(level, x, y) {
+            let packed = [a, a + dx, a + dy, a + dx + dy].map(|a| pack(a, level));
+            match self.merge {
+                Some(shift) if packed[0] >> shift == packed[3] >> shift => {
+                    self.put(0, packed[0], true);
+                    // `put` of one line just made or grew the last entry.
+                    if let Some(n) = self.counts[0].last_mut() {
+                        *n += 3;
+                    }
+                }
+                _ => packed.into_iter().for_each(|p| self.put(0, p, true)),
+            }
+            return;
+        }
+        self.texel(level, x, y);
+        self.texel(level, x + 1, y);
+        self.texel(level, x, y + 1);
+        self.texel(level, x + 1, y + 1);
+    }
+}
+
+impl<const ONE: bool> TexelSink for Recorder<'_, ONE> {
+    #[inline(always)]
+    fn texel(&mut self, level: u32, x: u32, y: u32) {
+        if ONE {
+            let a = pack(self.layouts[0].address(level, x, y), level);
+            self.put(0, a, true);
+        } else {
+            for i in 0..self.layouts.len() {
+                let a = pack(self.layouts[i].address(level, x, y), level);
+                self.put(i, a, true);
+            }
+        }
+    }
+    #[inline]
+    fn sat_entry(&mut self, x: u32, y: u32) {
+        for i in 0..self.layouts.len() {
+            if let Some(a) = self.layouts[i].sat_address(x, y) {
+                self.put(i, pack(a, SAT_LEVEL), false);
+            }
+        }
+    }
+}
+
+/// What a run models of the texture unit beside the cache.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Model {
+    /// Issue the frame by 2×2 quads ([`RasterOrder::quads`]): the texel
+    /// reads of a quad's pixels are one group, whose requests to one
+    /// cache line merge into one ([`Simulator::access_group`]).
+    pub quads: bool,
+    /// The prefetching unit's timings ([`Prefetch`]; all with one latency
+    /// and bandwidth), empty for none.
+    pub prefetch: Vec<Timing>,
+}
+
 /// What a scene run needs: the sampler (its filter), the chain's layout,
 /// the scene and how its pixels are visited.
 pub struct SceneSetup<'a> {
@@ -100,57 +212,62 @@ impl SceneSetup<'_> {
 
     /// The queries of the pixels that show texture, in raster order.
     pub fn queries(&self) -> Vec<Query> {
-        let tex = self.sampler.chain().level_size(0).unwrap_or((1, 1));
-        let frame = self.frame;
-        let scene = self.scene;
-        let pixels: Vec<(u32, u32)> = self.order.pixels(frame).collect();
-        pixels
+        let view = self.scene.view(self.frame, self.tex());
+        self.order
+            .pixel_list(self.frame)
             .par_chunks(CHUNK)
             .flat_map_iter(|c| {
                 c.iter()
-                    .filter_map(|&(x, y)| scene.query(frame, tex, x, y))
+                    .filter_map(|&(x, y)| view.query(x, y))
                     .collect::<Vec<_>>()
             })
             .collect()
     }
 
-    fn chunk_trace(&self, queries: &[Query]) -> Vec<u64> {
-        let mut sink = AddressSink::new(self.layout);
-        sink.out.reserve(queries.len() * 8);
-        let mut colours = vec![[0f32; 4]; queries.len()];
-        // Sampling cannot fail for a valid sampler and matching lengths.
-        let _ = self
-            .sampler
-            .sample_slice_traced(queries, &mut colours, &mut sink);
-        sink.out
+    fn tex(&self) -> (u32, u32) {
+        self.sampler.chain().level_size(0).unwrap_or((1, 1))
     }
 
-    /// Every access of the frame, in raster order (for sweeps, which replay
-    /// one trace under many caches). A `sat` sampler's table reads are
-    /// missing unless the layout has the table (see [`AddressSink`]).
+    fn tracer<'b>(&'b self, layouts: &'b [&'b ChainLayout], issue: Issue) -> Tracer<'b> {
+        Tracer {
+            sampler: self.sampler,
+            address_only: AddressOnly::new(self.sampler),
+            layouts,
+            view: self.scene.view(self.frame, self.tex()),
+            frame: self.frame,
+            order: self.order,
+            issue,
+        }
+    }
+
+    /// Every access of the frame, in raster order (for replaying one trace
+    /// under many caches). A `sat` sampler's table reads are missing
+    /// unless the layout has the table (see [`AddressSink`]).
     pub fn record(&self) -> Trace {
-        let queries = self.queries();
-        let chunks: Vec<Vec<u64>> = queries
+        let layouts = [self.layout];
+        let tracer = self.tracer(&layouts, Issue::Stream);
+        let units = tracer.units();
+        let chunks: Vec<Chunk> = units
             .par_chunks(CHUNK)
-            .map(|c| self.chunk_trace(c))
+            .map(|c| tracer.produce(c, None))
             .collect();
-        let mut accesses = Vec::with_capacity(chunks.iter().map(Vec::len).sum());
-        for c in chunks {
-            accesses.extend_from_slice(&c);
+        let n = chunks.iter().map(|c| c.accesses[0].len()).sum();
+        let mut accesses = Vec::with_capacity(n);
+        for c in &chunks {
+            accesses.extend_from_slice(&c.accesses[0]);
         }
         Trace {
             accesses,
-            pixels: queries.len() as u64,
+            pixels: chunks.iter().map(|c| c.pixels).sum(),
             texel_bytes: self.layout.texel(),
             sat_bytes: self.layout.sat_entry().unwrap_or(self.layout.texel()),
         }
     }
 
-    /// Simulate the frame under `l1` (and `l2`) with sampling and
-    /// simulation overlapped; `each` sees every packed access in order
-    /// (for `--trace-out`), `progress(done, total)` counts pixels. A `sat`
-    /// sampler needs a layout with its table
-    /// ([`ChainLayout::for_sampler`]).
+    /// Simulate the frame under `l1` (and `l2`), read by read, with
+    /// sampling and simulation overlapped; `each` sees every packed access
+    /// in order, `progress(done, total)` counts pixels visited. A `sat`
+    /// sampler needs a layout with its table ([`ChainLayout::for_sampler`]).
     pub fn simulate(
         &self,
         l1: &CacheConfig,
@@ -158,66 +275,452 @@ impl SceneSetup<'_> {
         each: &mut dyn FnMut(u64) -> Result<()>,
         progress: &(dyn Fn(u64, u64) + Sync),
     ) -> Result<RunStats> {
+        self.run(l1, l2, &Model::default(), Some(each), progress)
+    }
+
+    /// [`SceneSetup::simulate`] under `model` (quads, prefetching);
+    /// `each`, when given, sees every packed texel read in order (before
+    /// quads merge them); `progress(done, total)` counts the pixels or
+    /// quads visited.
+    pub fn run(
+        &self,
+        l1: &CacheConfig,
+        l2: Option<&CacheConfig>,
+        model: &Model,
+        each: Option<&mut dyn FnMut(u64) -> Result<()>>,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<RunStats> {
         if self.sampler.sat().is_some() && self.layout.sat_entry().is_none() {
             return Err(Error::InvalidOption(
                 "the sampler reads a summed-area table the cache layout does not lay out".into(),
             ));
         }
-        let queries = self.queries();
-        let total = queries.len() as u64;
-        let mut sim = Simulator::new(
-            l1,
-            l2,
-            AddressSpace::Bounded(self.layout.total_bytes()),
-            true,
-        )?;
-        let nlevels = self.layout.levels() as u32;
-        let texel = self.layout.texel();
-        let sat = self.layout.sat_entry().unwrap_or(texel);
-        let mut reads = 0u64;
-        let groups: Vec<&[Query]> = queries.chunks(CHUNK * 8).collect();
+        let layouts = [self.layout];
+        let tracer = self.tracer(&layouts, Issue::of(model));
+        let jobs = [Job {
+            layout: 0,
+            l1: *l1,
+            l2: l2.copied(),
+        }];
+        let mut runs = tracer.simulate(&jobs, model, each, progress)?;
+        runs.pop()
+            .ok_or_else(|| Error::InvalidOption("no cache to simulate".into()))
+    }
+
+    /// The frame traced once for every layout of `layouts` (this setup's
+    /// own layout aside) and simulated under every job of `jobs`, on all
+    /// of rayon's threads while the next pixels are sampled: the runs in
+    /// the order of `jobs`. `progress(done, total)` counts the pixels or
+    /// quads visited. A `sat` sampler needs layouts with its table.
+    pub fn run_jobs(
+        &self,
+        layouts: &[&ChainLayout],
+        jobs: &[Job],
+        model: &Model,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<Vec<RunStats>> {
+        if self.sampler.sat().is_some() && layouts.iter().any(|l| l.sat_entry().is_none()) {
+            return Err(Error::InvalidOption(
+                "the sampler reads a summed-area table a cache layout does not lay out".into(),
+            ));
+        }
+        if jobs.iter().any(|j| j.layout >= layouts.len()) {
+            return Err(Error::InvalidOption(
+                "a simulation names a layout the frame is not traced for".into(),
+            ));
+        }
+        self.tracer(layouts, Issue::of(model))
+            .simulate(jobs, model, None, progress)
+    }
+}
+
+/// One simulation of a frame traced by [`SceneSetup::run_jobs`]: which of
+/// its layouts, and the caches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Job {
+    /// Index into the layouts the frame is traced for.
+    pub layout: usize,
+    /// The first-level cache.
+    pub l1: CacheConfig,
+    /// The second-level cache.
+    pub l2: Option<CacheConfig>,
+}
+
+/// How the tracer issues the frame's reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Issue {
+    /// Pixels in slices, no fragment boundaries (the plain cache model).
+    Stream,
+    /// Pixel by pixel, each one fragment (the prefetch model needs them).
+    Pixels,
+    /// 2×2 quads, each one fragment.
+    Quads,
+}
+
+impl Issue {
+    fn of(model: &Model) -> Self {
+        if model.quads {
+            Issue::Quads
+        } else if !model.prefetch.is_empty() {
+            Issue::Pixels
+        } else {
+            Issue::Stream
+        }
+    }
+}
+
+/// A sampled piece of the frame: per layout the packed accesses, the end
+/// of each fragment in them (empty for [`Issue::Stream`]), the pixels
+/// that issued a query and the pixels or quads visited.
+struct Chunk {
+    accesses: Vec<Vec<u64>>,
+    /// Per layout, the reads each access stands for (see [`Recorder`]),
+    /// empty when every access is one read.
+    counts: Vec<Vec<u32>>,
+    ends: Vec<usize>,
+    pixels: u64,
+    units: u64,
+}
+
+/// Traces a frame: its pixels (or quads) in raster order, each query
+/// filtered by the sampler and its reads recorded in every layout.
+struct Tracer<'a> {
+    sampler: &'a Sampler,
+    /// The sampler's reads without its texels, when it is isotropic.
+    address_only: Option<AddressOnly>,
+    layouts: &'a [&'a ChainLayout],
+    view: View,
+    frame: Frame,
+    order: RasterOrder,
+    issue: Issue,
+}
+
+impl Tracer<'_> {
+    /// The pixels, or quads, in raster order.
+    fn units(&self) -> Vec<(u32, u32)> {
+        match self.issue {
+            Issue::Quads => self.order.quads(self.frame),
+            _ => self.order.pixel_list(self.frame),
+        }
+    }
+
+    /// Sample `units` (pixels or quads); `merge`: see [`Recorder`].
+    fn produce(&self, units: &[(u32, u32)], merge: Option<u32>) -> Chunk {
+        // About eight reads per pixel (trilinear) to start with.
+        let reserve = units.len() * if self.issue == Issue::Quads { 32 } else { 8 };
+        if self.layouts.len() == 1 {
+            self.produce_into(units, Recorder::<true>::new(self.layouts, merge, reserve))
+        } else {
+            self.produce_into(units, Recorder::<false>::new(self.layouts, merge, reserve))
+        }
+    }
+
+    fn produce_into<const ONE: bool>(
+        &self,
+        units: &[(u32, u32)],
+        mut sink: Recorder<'_, ONE>,
+    ) -> Chunk {
+        let mut ends = Vec::new();
+        let mut colours = Vec::new();
+        let mut pixels = 0u64;
+        match self.issue {
+            Issue::Stream => {
+                let qs: Vec<Query> = units
+                    .iter()
+                    .filter_map(|&(x, y)| self.view.query(x, y))
+                    .collect();
+                self.trace(&qs, &mut colours, &mut sink);
+                pixels = qs.len() as u64;
+            }
+            Issue::Pixels => {
+                for &(x, y) in units {
+                    if let Some(q) = self.view.query(x, y) {
+                        self.trace(std::slice::from_ref(&q), &mut colours, &mut sink);
+                        ends.push(sink.len());
+                        pixels += 1;
+                    }
+                }
+            }
+            Issue::Quads => {
+                let (w, h) = (self.frame.width, self.frame.height);
+                let mut qs = Vec::with_capacity(4);
+                for &(qx, qy) in units {
+                    qs.clear();
+                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                        let (x, y) = (2 * qx + dx, 2 * qy + dy);
+                        if x < w && y < h {
+                            qs.extend(self.view.query(x, y));
+                        }
+                    }
+                    if !qs.is_empty() {
+                        self.trace(&qs, &mut colours, &mut sink);
+                        ends.push(sink.len());
+                        pixels += qs.len() as u64;
+                    }
+                }
+            }
+        }
+        Chunk {
+            accesses: sink.out,
+            counts: if sink.merge.is_some() {
+                sink.counts
+            } else {
+                Vec::new()
+            },
+            ends,
+            pixels,
+            units: units.len() as u64,
+        }
+    }
+
+    /// Report the reads of `qs` to `sink`: address only when the sampler
+    /// is isotropic, else by sampling (into `colours`, resized).
+    #[inline]
+    fn trace<S: BlockSink>(&self, qs: &[Query], colours: &mut Vec<[f32; 4]>, sink: &mut S) {
+        if let Some(a) = &self.address_only {
+            for q in qs {
+                a.trace_blocks(q, sink);
+            }
+            return;
+        }
+        colours.resize(qs.len(), [0.0; 4]);
+        // Sampling cannot fail for a valid sampler and matching lengths.
+        let _ = self
+            .sampler
+            .sample_slice_traced(qs, &mut colours[..qs.len()], sink);
+    }
+
+    /// The line size (as a shift) at which consecutive reads may be kept
+    /// as one entry for `jobs` (see [`Recorder`]): the smallest line of
+    /// their first levels, when a texel read lies within one line and no
+    /// cache has sectors (whose repeats may want other sectors), and the
+    /// reads are neither written out nor grouped into fragments.
+    fn merge_shift(&self, jobs: &[Job], writing: bool) -> Option<u32> {
+        let line = jobs.iter().map(|j| j.l1.line).min()?;
+        let texel = self.layouts.iter().map(|l| l.texel()).max()?;
+        let plain = jobs.iter().all(|j| j.l1.sector.is_none());
+        (self.issue == Issue::Stream && !writing && plain && texel <= line)
+            .then(|| line.trailing_zeros())
+    }
+
+    /// Sample the frame in groups (on the pool) and feed every group to
+    /// every job's simulator in order (here, the jobs in parallel).
+    fn simulate(
+        &self,
+        jobs: &[Job],
+        model: &Model,
+        mut each: Option<&mut dyn FnMut(u64) -> Result<()>>,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) -> Result<Vec<RunStats>> {
+        let mut consumers = jobs
+            .iter()
+            .map(|j| Consumer::new(j, self.layouts[j.layout], model))
+            .collect::<Result<Vec<_>>>()?;
+        let merge = self.merge_shift(jobs, each.is_some());
+        let units = self.units();
+        let total = units.len() as u64;
+        let mut done = 0u64;
+        // Fewer pixels per group when each read is kept in several
+        // layouts: up to three groups are held at once.
+        let group = if self.layouts.len() > 1 {
+            CHUNK * 2
+        } else {
+            CHUNK * 8
+        };
+        let groups: Vec<&[(u32, u32)]> = units.chunks(group).collect();
         // Sampling (on the pool) overlaps simulation (here), unless this
         // is a pool thread: see crate::par.
-        let result = crate::par::produce_consume(
+        crate::par::produce_consume(
             &groups,
             2,
-            |_, g| -> Vec<Vec<u64>> { g.par_chunks(CHUNK).map(|c| self.chunk_trace(c)).collect() },
-            |gi, traces| -> Result<()> {
-                for t in &traces {
-                    for &a in t {
-                        let (addr, level) = unpack(a);
-                        let (bytes, index) = if level == SAT_LEVEL {
-                            (sat, nlevels)
-                        } else {
-                            (texel, level)
-                        };
-                        sim.access(addr, bytes, index);
-                        each(a)?;
+            |_, g| -> Vec<Chunk> {
+                g.par_chunks(CHUNK)
+                    .map(|c| self.produce(c, merge))
+                    .collect()
+            },
+            |_, chunks| -> Result<()> {
+                if let [one] = consumers.as_mut_slice() {
+                    for c in &chunks {
+                        one.consume(c, &mut each)?;
                     }
-                    reads += t.len() as u64;
+                } else {
+                    consumers.par_iter_mut().try_for_each(|k| {
+                        chunks.iter().try_for_each(|c| k.consume(c, &mut None))
+                    })?;
                 }
-                progress(((gi + 1) * CHUNK * 8).min(total as usize) as u64, total);
+                done += chunks.iter().map(|c| c.units).sum::<u64>();
+                progress(done, total);
                 Ok(())
             },
-        );
-        result?;
-        Ok(RunStats {
-            stats: sim.into_stats(),
-            pixels: total,
-            reads,
+        )?;
+        Ok(consumers.into_iter().map(Consumer::finish).collect())
+    }
+}
+
+/// One job's simulator fed a traced frame, with its prefetch model.
+struct Consumer {
+    layout: usize,
+    sim: Simulator,
+    texel: u64,
+    sat: u64,
+    levels: u32,
+    quads: bool,
+    prefetch: Option<Prefetch>,
+    /// The current fragment's requests: (line, missed).
+    lines: Vec<(u64, bool)>,
+    reads: u64,
+    pixels: u64,
+    fragments: u64,
+}
+
+impl Consumer {
+    fn new(job: &Job, layout: &ChainLayout, model: &Model) -> Result<Self> {
+        let space = AddressSpace::Bounded(layout.total_bytes());
+        let prefetch = match model.prefetch.as_slice() {
+            [] => None,
+            t => {
+                let lines = (layout.total_bytes() >> job.l1.line.trailing_zeros()) + 1;
+                Some(Prefetch::new(t, lines)?)
+            }
+        };
+        Ok(Consumer {
+            layout: job.layout,
+            sim: Simulator::new(&job.l1, job.l2.as_ref(), space, true)?,
+            texel: layout.texel(),
+            sat: layout.sat_entry().unwrap_or(layout.texel()),
+            levels: layout.levels() as u32,
+            quads: model.quads,
+            prefetch,
+            lines: Vec::new(),
+            reads: 0,
+            pixels: 0,
+            fragments: 0,
         })
+    }
+
+    /// (address, bytes, level counter) of a packed access.
+    #[inline(always)]
+    fn decode(&self) -> impl Fn(u64) -> (u64, u64, u32) + use<> {
+        let (texel, sat, levels) = (self.texel, self.sat, self.levels);
+        move |a| {
+            let (addr, level) = unpack(a);
+            if level == SAT_LEVEL {
+                (addr, sat, levels)
+            } else {
+                (addr, texel, level)
+            }
+        }
+    }
+
+    fn consume(
+        &mut self,
+        c: &Chunk,
+        each: &mut Option<&mut dyn FnMut(u64) -> Result<()>>,
+    ) -> Result<()> {
+        let acc = &c.accesses[self.layout];
+        self.pixels += c.pixels;
+        if let Some(counts) = c.counts.get(self.layout) {
+            // Merged repeats (see `Recorder`): no reads written, no
+            // fragments.
+            self.fragments += c.pixels;
+            let decode = self.decode();
+            for (&a, &n) in acc.iter().zip(counts) {
+                let (addr, bytes, level) = decode(a);
+                self.sim.access(addr, bytes, level);
+                if n > 1 {
+                    self.sim.repeat_hits(level, n as u64 - 1);
+                }
+                self.reads += n as u64;
+            }
+            return Ok(());
+        }
+        self.reads += acc.len() as u64;
+        if let Some(each) = each {
+            for &a in acc {
+                each(a)?;
+            }
+        }
+        if c.ends.is_empty() {
+            self.fragments += c.pixels;
+            let decode = self.decode();
+            for &a in acc {
+                let (addr, bytes, level) = decode(a);
+                self.sim.access(addr, bytes, level);
+            }
+            return Ok(());
+        }
+        let mut from = 0;
+        for &end in &c.ends {
+            let fragment = &acc[from..end];
+            from = end;
+            self.fragment(fragment);
+        }
+        self.fragments += c.ends.len() as u64;
+        Ok(())
+    }
+
+    /// One fragment's reads: through the cache (merged per line for a
+    /// quad), then the prefetch model.
+    fn fragment(&mut self, reads: &[u64]) {
+        let mut lines = std::mem::take(&mut self.lines);
+        lines.clear();
+        let mut note = |line: u64, o: Outcome| lines.push((line, o != Outcome::Hit));
+        let decode = self.decode();
+        if self.quads {
+            self.sim
+                .access_group(reads.iter().map(|&a| decode(a)), &mut note);
+        } else {
+            for &a in reads {
+                let (addr, bytes, level) = decode(a);
+                self.sim.access_with(addr, bytes, level, &mut note);
+            }
+        }
+        if let Some(p) = &mut self.prefetch {
+            p.fragment(&lines);
+        }
+        self.lines = lines;
+    }
+
+    fn finish(self) -> RunStats {
+        RunStats {
+            stats: self.sim.into_stats(),
+            pixels: self.pixels,
+            reads: self.reads,
+            quads: self.quads.then_some(self.fragments),
+            prefetch: self.prefetch.map_or_else(Vec::new, |p| p.stats()),
+        }
     }
 }
 
 /// Statistics of a scene run.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RunStats {
-    /// The cache counters.
+    /// The cache counters (its accesses are the line requests: per texel
+    /// read, or per line per quad with [`Model::quads`]).
     pub stats: Stats,
     /// Pixels that issued a query.
     pub pixels: u64,
     /// Texel (or table-entry) reads.
     pub reads: u64,
+    /// Quads that issued a query, when the frame was issued by quads.
+    pub quads: Option<u64>,
+    /// The prefetch model's statistics, one per timing of the
+    /// [`Model`].
+    pub prefetch: Vec<PrefetchStats>,
+}
+
+impl RunStats {
+    /// A run's statistics from its counters alone (no quads, no
+    /// prefetching).
+    pub fn plain(stats: Stats, pixels: u64, reads: u64) -> Self {
+        RunStats {
+            stats,
+            pixels,
+            reads,
+            quads: None,
+            prefetch: Vec::new(),
+        }
+    }
 }
 
 /// A recorded frame: packed accesses in raster order.
@@ -252,11 +755,11 @@ impl Trace {
                 sim.access(addr, self.texel_bytes, level);
             }
         }
-        Ok(RunStats {
-            stats: sim.into_stats(),
-            pixels: self.pixels,
-            reads: self.accesses.len() as u64,
-        })
+        Ok(RunStats::plain(
+            sim.into_stats(),
+            self.pixels,
+            self.accesses.len() as u64,
+        ))
     }
 }
 

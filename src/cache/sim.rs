@@ -18,9 +18,9 @@
 //! Two stores, chosen by associativity: up to 16 ways, each set's tags sit
 //! in one short array (recency order for LRU, slot order otherwise) and a
 //! lookup is a scan of W tags; above that (fully associative caches, the
-//! 3C shadow) a line → way index (a dense table when the address space is
-//! known, as in scene mode; a hash map for arbitrary traces) and per-set
-//! linked lists make every access O(1). A plain model
+//! 3C shadow) a line → way index (an open-addressing table sized by the
+//! cache, small enough to stay in the processor's cache) and per-set
+//! queues of use stamps make every access O(1) amortised. A plain model
 //! ([`super::reference`]) is tested against both, access by access.
 
 use std::collections::HashMap;
@@ -341,46 +341,82 @@ pub enum AddressSpace {
     Any,
 }
 
-/// line → value, dense or hashed.
-enum Index {
-    Dense(Vec<u32>),
-    Hash(LineMap<u32>),
+/// line → slot of a store with more than 16 ways: open addressing with
+/// linear probing in a table of two to four times as many entries as the
+/// store has slots, and backward-shift deletion. It is sized by the cache,
+/// not by the address space, so that it stays in the processor's cache
+/// (12 KiB for the 256 lines of a 16 KiB cache's 3C shadow): a lookup is a
+/// multiplication and one or two probes.
+struct Index {
+    keys: Vec<u64>,
+    /// The slot of each entry; [`NONE`] marks a free entry.
+    values: Vec<u32>,
+    shift: u32,
+    mask: usize,
 }
 
 const NONE: u32 = u32::MAX;
 
 impl Index {
-    fn new(space: AddressSpace, line_shift: u32) -> Self {
-        match space {
-            AddressSpace::Bounded(b) if (b >> line_shift) < (1 << 28) => {
-                Index::Dense(vec![NONE; ((b >> line_shift) + 1) as usize])
-            }
-            _ => Index::Hash(LineMap::default()),
+    fn new(slots: usize) -> Self {
+        let factor = if slots <= 1 << 16 { 4 } else { 2 };
+        let n = (slots * factor).next_power_of_two().max(16);
+        Index {
+            keys: vec![0; n],
+            values: vec![NONE; n],
+            shift: 64 - n.trailing_zeros(),
+            mask: n - 1,
         }
+    }
+    #[inline(always)]
+    fn home(&self, line: u64) -> usize {
+        (line.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> self.shift) as usize
+    }
+    /// The entry holding `line`, or the free entry where it would go.
+    #[inline(always)]
+    fn find(&self, line: u64) -> usize {
+        let mut i = self.home(line);
+        while self.values[i] != NONE && self.keys[i] != line {
+            i = (i + 1) & self.mask;
+        }
+        i
     }
     #[inline]
     fn get(&self, line: u64) -> u32 {
-        match self {
-            Index::Dense(v) => v.get(line as usize).copied().unwrap_or(NONE),
-            Index::Hash(m) => m.get(&line).copied().unwrap_or(NONE),
-        }
+        self.values[self.find(line)]
     }
     #[inline]
     fn set(&mut self, line: u64, value: u32) {
-        match self {
-            Index::Dense(v) => {
-                if let Some(x) = v.get_mut(line as usize) {
-                    *x = value;
-                }
+        let mut i = self.find(line);
+        if value != NONE {
+            self.keys[i] = line;
+            self.values[i] = value;
+            return;
+        }
+        if self.values[i] == NONE {
+            return;
+        }
+        // Backward shift: move later entries of the probe run into the
+        // hole unless their home lies cyclically in (hole, entry].
+        let mut j = i;
+        loop {
+            j = (j + 1) & self.mask;
+            if self.values[j] == NONE {
+                break;
             }
-            Index::Hash(m) => {
-                if value == NONE {
-                    m.remove(&line);
-                } else {
-                    m.insert(line, value);
-                }
+            let k = self.home(self.keys[j]);
+            let stays = if i <= j {
+                i < k && k <= j
+            } else {
+                i < k || k <= j
+            };
+            if !stays {
+                self.keys[i] = self.keys[j];
+                self.values[i] = self.values[j];
+                i = j;
             }
         }
+        self.values[i] = NONE;
     }
 }
 
@@ -412,15 +448,22 @@ enum Store {
         index: Index,
         line: Vec<u64>,
         mask: Vec<u32>,
-        prev: Vec<u32>,
-        next: Vec<u32>,
-        head: Vec<u32>,
+        /// When each slot was last used (LRU) or filled (FIFO).
+        stamp: Vec<u64>,
+        /// Per set, (slot, stamp) in the order of use: an entry whose
+        /// stamp is still its slot's is live, the others are stale (the
+        /// slot was used again later). The first live entry is the least
+        /// recent (oldest) slot. A hit is a stamp and a push, no list to
+        /// relink; stale entries are skipped when a victim is sought and
+        /// dropped when the queue grows past four per way.
+        queue: Vec<Queue>,
+        clock: u64,
         fill: Vec<u32>,
     },
 }
 
 impl Cache {
-    fn new(c: &CacheConfig, space: AddressSpace) -> Self {
+    fn new(c: &CacheConfig) -> Self {
         let sets = c.sets();
         let ways = c.ways as usize;
         let slots = c.lines() as usize;
@@ -433,12 +476,12 @@ impl Cache {
             }
         } else {
             Store::Large {
-                index: Index::new(space, c.line.trailing_zeros()),
+                index: Index::new(slots),
                 line: vec![EMPTY; slots],
                 mask: vec![0; slots],
-                prev: vec![NONE; slots],
-                next: vec![NONE; slots],
-                head: vec![NONE; sets as usize],
+                stamp: vec![0; slots],
+                queue: vec![Queue::default(); sets as usize],
+                clock: 0,
                 fill: vec![0; sets as usize],
             }
         };
@@ -527,22 +570,25 @@ impl Cache {
             index,
             line: lines,
             mask,
-            prev,
-            next,
-            head,
+            stamp,
+            queue,
+            clock,
             fill,
         } = &mut self.store
         else {
             unreachable!("touch_large on a small store")
         };
+        let queue = &mut queue[set];
         let s = index.get(line);
         if s != NONE {
             let s = s as usize;
             let missing = want & !mask[s];
             mask[s] |= want;
-            if policy == Policy::Lru && head[set] != s as u32 {
-                unlink(prev, next, head, set, s);
-                link_head(prev, next, head, set, s);
+            // Already the most recent: nothing to reorder.
+            if policy == Policy::Lru && queue.last() != Some((s as u32, stamp[s])) {
+                *clock += 1;
+                stamp[s] = *clock;
+                queue.push((s as u32, *clock), ways, stamp);
             }
             return (missing, mask[s]);
         }
@@ -555,19 +601,74 @@ impl Cache {
             index.set(lines[victim], NONE);
             victim
         } else {
-            // The tail (least recent / oldest) is the head's prev.
-            let victim = prev[head[set] as usize] as usize;
+            let victim = queue.pop_oldest(stamp);
             index.set(lines[victim], NONE);
-            unlink(prev, next, head, set, victim);
             victim
         };
         lines[slot] = line;
         mask[slot] = want;
         index.set(line, slot as u32);
         if policy != Policy::Random {
-            link_head(prev, next, head, set, slot);
+            *clock += 1;
+            stamp[slot] = *clock;
+            queue.push((slot as u32, *clock), ways, stamp);
         }
         (want, want)
+    }
+}
+
+/// One set's (slot, stamp) entries in the order of use, from `head` on
+/// (see `Store::Large`).
+#[derive(Clone, Debug, Default)]
+struct Queue {
+    entries: Vec<(u32, u64)>,
+    head: usize,
+}
+
+impl Queue {
+    #[inline(always)]
+    fn last(&self) -> Option<(u32, u64)> {
+        self.entries.last().copied()
+    }
+
+    /// Append an entry; past four entries per way (and a few) in the
+    /// queue, or as many popped ones before it, keep only the live ones
+    /// (in order): the memory stays within a few entries per way.
+    #[inline(always)]
+    fn push(&mut self, e: (u32, u64), ways: usize, stamp: &[u64]) {
+        self.entries.push(e);
+        let limit = 4 * ways + 16;
+        if self.entries.len() - self.head > limit || self.head > limit {
+            self.compact(stamp);
+        }
+    }
+
+    #[inline(never)]
+    fn compact(&mut self, stamp: &[u64]) {
+        let mut j = 0;
+        for i in self.head..self.entries.len() {
+            let (k, t) = self.entries[i];
+            if stamp[k as usize] == t {
+                self.entries[j] = (k, t);
+                j += 1;
+            }
+        }
+        self.entries.truncate(j);
+        self.head = 0;
+    }
+
+    /// Remove and return the oldest live slot. A full set has a live
+    /// entry per slot; an empty queue (which a full set never has) gives
+    /// slot 0 rather than a panic.
+    #[inline(always)]
+    fn pop_oldest(&mut self, stamp: &[u64]) -> usize {
+        while let Some(&(k, t)) = self.entries.get(self.head) {
+            self.head += 1;
+            if stamp[k as usize] == t {
+                return k as usize;
+            }
+        }
+        0
     }
 }
 
@@ -597,38 +698,6 @@ pub(crate) fn xorshift(state: &mut u64) -> u64 {
     x ^= x >> 27;
     *state = x;
     x.wrapping_mul(0x2545_F491_4F6C_DD1D)
-}
-
-/// Remove slot `s` from set `set`'s circular list.
-#[inline]
-fn unlink(prev: &mut [u32], next: &mut [u32], head: &mut [u32], set: usize, s: usize) {
-    let (p, n) = (prev[s], next[s]);
-    if n as usize == s {
-        head[set] = NONE;
-    } else {
-        next[p as usize] = n;
-        prev[n as usize] = p;
-        if head[set] as usize == s {
-            head[set] = n;
-        }
-    }
-}
-
-/// Put slot `s` at the head of set `set`'s circular list.
-#[inline]
-fn link_head(prev: &mut [u32], next: &mut [u32], head: &mut [u32], set: usize, s: usize) {
-    let h = head[set];
-    if h == NONE {
-        prev[s] = s as u32;
-        next[s] = s as u32;
-    } else {
-        let t = prev[h as usize];
-        next[t as usize] = s as u32;
-        prev[s] = t;
-        next[s] = h;
-        prev[h as usize] = s as u32;
-    }
-    head[set] = s as u32;
 }
 
 /// Lines (and sectors) ever touched: the cold-miss test and the working set.
@@ -700,6 +769,8 @@ pub struct Simulator {
     /// no state (it is most recent in both already).
     last_line: u64,
     last_mask: u32,
+    /// [`Simulator::access_group`]'s lines: (line, sectors, level).
+    group: Vec<(u64, u32, u32)>,
 }
 
 impl Simulator {
@@ -718,10 +789,10 @@ impl Simulator {
         let line_shift = l1.line.trailing_zeros();
         let sector = l1.sector.unwrap_or(l1.line);
         Ok(Simulator {
-            l1: Cache::new(l1, space),
-            shadow: classify.then(|| Cache::new(&l1.fully_associative(), space)),
+            l1: Cache::new(l1),
+            shadow: classify.then(|| Cache::new(&l1.fully_associative())),
             touched: Touched::new(space, line_shift),
-            l2: l2.map(|c| Cache::new(c, space)),
+            l2: l2.map(Cache::new),
             l2_line_shift: l2.map_or(0, |c| c.line.trailing_zeros()),
             l2_sector_shift: l2.map_or(0, |c| c.sector.unwrap_or(c.line).trailing_zeros()),
             l2_sectors: l2.map_or(1, |c| c.sector.map_or(1, |s| (c.line / s) as u32)),
@@ -734,6 +805,7 @@ impl Simulator {
             },
             last_line: u64::MAX,
             last_mask: 0,
+            group: Vec::new(),
         })
     }
 
@@ -772,6 +844,17 @@ impl Simulator {
         self.access_inner(address, bytes, level, |_, _| {});
     }
 
+    /// `n` more accesses of the line the last access touched, at `level`:
+    /// hits that change nothing (the line is most recent in the cache and
+    /// in the shadow). Only for a last access that touched one line and
+    /// wanted all of its sectors, as a texel read of a cache without
+    /// sectors does (the fast path of [`Simulator::access`] for a repeat).
+    #[inline]
+    pub(crate) fn repeat_hits(&mut self, level: u32, n: u64) {
+        self.level_counters(level);
+        self.stats.per_level[level as usize].accesses += n;
+    }
+
     /// [`Simulator::access`], calling `each(line, outcome)` for every line
     /// the access touches (tests compare these sequences).
     pub fn access_with(
@@ -792,29 +875,75 @@ impl Simulator {
         level: u32,
         mut each: impl FnMut(u64, Outcome),
     ) {
+        self.level_counters(level);
         let end = address.saturating_add(bytes.max(1) - 1);
         let (first, last) = (address >> self.line_shift, end >> self.line_shift);
-        if (level as usize) >= self.stats.per_level.len() {
-            self.stats
-                .per_level
-                .resize(level as usize + 1, Counters::default());
-        }
         if first == last && self.sector_shift == self.line_shift {
             // The common case: one line, no sectors.
             let o = self.touch_line(first, 1, level);
             each(first, o);
             return;
         }
-        let line_mask = (1u64 << self.line_shift) - 1;
         for line in first..=last {
-            let base = line << self.line_shift;
-            let lo = address.max(base) - base;
-            let hi = end.min(base + line_mask) - base;
-            let (s0, s1) = (lo >> self.sector_shift, hi >> self.sector_shift);
-            let want = (((1u64 << (s1 + 1)) - 1) as u32) & !(((1u64 << s0) - 1) as u32);
+            let want = self.sectors(address, end, line);
             let o = self.touch_line(line, want, level);
             each(line, o);
         }
+    }
+
+    /// Make sure level `level` has counters.
+    #[inline(always)]
+    fn level_counters(&mut self, level: u32) {
+        if (level as usize) >= self.stats.per_level.len() {
+            self.stats
+                .per_level
+                .resize(level as usize + 1, Counters::default());
+        }
+    }
+
+    /// The sectors of `line` that bytes `address ..= end` touch.
+    #[inline(always)]
+    fn sectors(&self, address: u64, end: u64, line: u64) -> u32 {
+        if self.sector_shift == self.line_shift {
+            return 1;
+        }
+        let line_mask = (1u64 << self.line_shift) - 1;
+        let base = line << self.line_shift;
+        let lo = address.max(base) - base;
+        let hi = end.min(base + line_mask) - base;
+        let (s0, s1) = (lo >> self.sector_shift, hi >> self.sector_shift);
+        (((1u64 << (s1 + 1)) - 1) as u32) & !(((1u64 << s0) - 1) as u32)
+    }
+
+    /// Accesses read together (a 2×2 quad's texel reads), each `(address,
+    /// bytes, level)`: every line they touch is requested once, in the
+    /// order first touched, wanting every sector any of them touches, and
+    /// counted at the level of the access that first touched it;
+    /// `each(line, outcome)` is called per request.
+    pub fn access_group(
+        &mut self,
+        accesses: impl IntoIterator<Item = (u64, u64, u32)>,
+        mut each: impl FnMut(u64, Outcome),
+    ) {
+        let mut group = std::mem::take(&mut self.group);
+        group.clear();
+        for (address, bytes, level) in accesses {
+            let end = address.saturating_add(bytes.max(1) - 1);
+            for line in (address >> self.line_shift)..=(end >> self.line_shift) {
+                let want = self.sectors(address, end, line);
+                // Most repeats are of the line just added.
+                match group.iter_mut().rev().find(|g| g.0 == line) {
+                    Some(g) => g.1 |= want,
+                    None => group.push((line, want, level)),
+                }
+            }
+        }
+        for &(line, want, level) in &group {
+            self.level_counters(level);
+            let o = self.touch_line(line, want, level);
+            each(line, o);
+        }
+        self.group = group;
     }
 
     #[inline(always)]

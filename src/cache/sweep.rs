@@ -1,9 +1,10 @@
 //! Cache sweeps: one scene's texel reads under a grid of caches, memory
 //! layouts and filters.
 //!
-//! Each (filter, layout) pair's frame is sampled once and its accesses
-//! recorded ([`SceneSetup::record`]); the recorded trace is then replayed
-//! under every cache of the grid in parallel. [`sweep`] returns one
+//! Each filter's frame is sampled once; every texel read is addressed in
+//! every layout of the grid, and the reads flow in raster order to one
+//! simulator per (layout, cache) pair, all run in parallel while the next
+//! pixels are sampled ([`SceneSetup::run_jobs`]): no trace is stored. [`sweep`] returns one
 //! [`SweepRow`] per configuration, filters outermost, then layouts, then
 //! caches in the order given; it writes nothing.
 //!
@@ -26,11 +27,12 @@
 //! # Ok::<(), parvo::Error>(())
 //! ```
 
-use rayon::prelude::*;
+use std::sync::Arc;
 
 use super::layout::{ChainLayout, Layout};
-use super::run::{RunStats, SceneSetup};
-use super::sim::{AddressSpace, CacheConfig};
+use super::run::{Job, Model, RunStats, SceneSetup};
+use super::shape::CacheTexture;
+use super::sim::CacheConfig;
 use crate::compress::BlockFormat;
 use crate::error::Result;
 use crate::mip::MipChain;
@@ -104,44 +106,65 @@ pub fn cache_grid(
 /// Run every configuration of `settings` on `chain` (`blocks`: the block
 /// format its levels were stored in, whose reads fetch whole blocks);
 /// `progress` is called once per configuration done, from any thread.
+/// (The chain is copied once; [`sweep_with`] reads a shared one, or a
+/// stand-in.)
 pub fn sweep(
     chain: &MipChain,
     blocks: Option<BlockFormat>,
     settings: &SweepSettings,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<SweepRow>> {
+    let texture = CacheTexture::loaded(Arc::new(chain.clone()), blocks);
+    sweep_with(&texture, settings, &Model::default(), progress)
+}
+
+/// [`sweep`] of `texture` under `model` (quads, prefetching): each
+/// filter's frame is sampled once, its reads addressed in every layout,
+/// and every (layout, cache) pair simulated from them in parallel.
+pub fn sweep_with(
+    texture: &CacheTexture,
+    settings: &SweepSettings,
+    model: &Model,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<SweepRow>> {
     let mut rows = Vec::with_capacity(settings.configurations());
+    let mut jobs = Vec::new();
+    for layout in 0..settings.layouts.len() {
+        for c in &settings.caches {
+            jobs.push(Job {
+                layout,
+                l1: *c,
+                l2: None,
+            });
+        }
+    }
     for (name, options) in &settings.filters {
-        let sampler = Sampler::new(chain, *options)?;
-        for &layout in &settings.layouts {
-            let cl = ChainLayout::for_sampler_stored(chain, &sampler, layout, blocks);
-            let setup = SceneSetup {
-                sampler: &sampler,
-                layout: &cl,
-                scene: settings.scene,
-                frame: settings.frame,
-                order: settings.order,
-            };
-            let trace = setup.record();
-            let space = AddressSpace::Bounded(cl.total_bytes());
-            let levels = chain.len() as u32;
-            let runs: Vec<Result<SweepRow>> = settings
-                .caches
-                .par_iter()
-                .map(|c| {
-                    let run = trace.simulate(c, None, space, levels)?;
-                    progress();
-                    Ok(SweepRow {
-                        filter: name.clone(),
-                        layout,
-                        cache: *c,
-                        run,
-                    })
-                })
-                .collect();
-            for r in runs {
-                rows.push(r?);
-            }
+        let sampler = Sampler::shared(texture.chain.clone(), *options)?;
+        let layouts: Vec<ChainLayout> = settings
+            .layouts
+            .iter()
+            .map(|&l| texture.layout(&sampler, l))
+            .collect();
+        let refs: Vec<&ChainLayout> = layouts.iter().collect();
+        let Some(&first) = refs.first() else {
+            continue;
+        };
+        let setup = SceneSetup {
+            sampler: &sampler,
+            layout: first,
+            scene: settings.scene,
+            frame: settings.frame,
+            order: settings.order,
+        };
+        let runs = setup.run_jobs(&refs, &jobs, model, &|_, _| {})?;
+        for (job, run) in jobs.iter().zip(runs) {
+            progress();
+            rows.push(SweepRow {
+                filter: name.clone(),
+                layout: settings.layouts[job.layout],
+                cache: job.l1,
+                run,
+            });
         }
     }
     Ok(rows)

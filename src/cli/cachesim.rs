@@ -10,6 +10,10 @@
 //!   scene's reads in that format;
 //! - `--sweep`: a grid of cache sizes, line sizes, associativities,
 //!   layouts and filters, in parallel, to `DIR/sweep.csv` and an SVG plot.
+//!
+//! Scene runs and sweeps take `--quads` (a 2×2 quad's reads of one line
+//! are one request); scene runs take `--prefetch` (the misses timed in a
+//! prefetching texture unit, `parvo::cache::prefetch`).
 
 use std::fs::File;
 use std::io::{BufReader, IsTerminal, Write};
@@ -19,10 +23,16 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, anyhow, bail};
 use indicatif::ProgressBar;
 
+use std::sync::Arc;
+
 use parvo::cache::layout::{ChainLayout, Layout};
-use parvo::cache::run::{RunStats, SceneSetup, read_trace, unpack, write_trace_line};
+use parvo::cache::prefetch::{PrefetchStats, Timing};
+use parvo::cache::run::{Model, RunStats, SceneSetup, read_trace, unpack, write_trace_line};
+use parvo::cache::shape::{self, CacheTexture};
 use parvo::cache::sim::{AddressSpace, CacheConfig, Counters, Simulator, parse_size};
-use parvo::cache::sweep::{SweepRow, SweepSettings, cache_grid, sweep};
+use parvo::cache::sweep::{SweepRow, SweepSettings, cache_grid, sweep_with};
+
+use super::mip::ColorArg;
 use parvo::sample::{MipMode, Sampler, SamplerOptions};
 use parvo::scene::{Frame, RasterOrder, Scene};
 
@@ -36,7 +46,8 @@ use parvo::scene::{Frame, RasterOrder, Scene};
     bytes that reach memory, in total and per mip level.\n\n\
     Modes: scene (default); --trace FILE (an address trace, one decimal or 0x-hex address per line, \
     `#` comments; - for stdin); --sweep (a grid of caches × layouts × filters to --out DIR as CSV \
-    and SVG).\n\n\
+    and SVG). --quads issues 2x2 quads whose reads of one line merge; --prefetch times the misses \
+    in a prefetching texture unit.\n\n\
     Cache spec: SIZE:LINE:WAYS[:POLICY], SIZE as 16384, 16K, 16KiB or 4M, WAYS a number or `full`, \
     POLICY lru (default), fifo or random. Layouts: linear, tiled:WxH, morton, morton:WxH, \
     blocked:WxH:SWxSH. Orders: scanline, tiled:N, morton, hilbert. Scenes: plane, tunnel, zoom, \
@@ -127,6 +138,49 @@ pub struct CachesimArgs {
     /// Sweep: output directory for sweep.csv and sweep.svg.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Issue the frame by 2x2 quads: a quad's texel reads of one cache line are one request.
+    #[arg(
+        long,
+        long_help = "Issue the frame by 2x2 quads, as GPUs shade: the four pixels of a quad are \
+        filtered together and their texel reads of one cache line merge into one request. The \
+        raster order runs over the grid of quads (tiled:N in tiles of N pixels rounded up to whole \
+        quads). The report adds the quads, the line requests and the line fetches beside the \
+        per-texel reads."
+    )]
+    quads: bool,
+    /// Prefetching texture unit: FIFO depths in fragments, e.g. 0,16,64,256 (0: a blocking cache).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "DEPTHS",
+        value_parser = clap::value_parser!(u32).range(0..=1 << 20),
+        conflicts_with = "sweep",
+        long_help = "Time the cache's misses in a prefetching texture unit after Igehy, Eldridge \
+        and Proudfoot (1998): tags are looked up when a fragment (a pixel, or a quad with --quads) \
+        enters, its missing lines are requested at once, and it waits in a FIFO of DEPTH fragments \
+        until they are back; the unit filters one fragment per cycle. One row per depth: cycles, \
+        cycles lost to memory, stall-free hit rate, and the share of a blocking cache's lost cycles \
+        the FIFO recovers. See --latency and --request-cycles."
+    )]
+    prefetch: Vec<u32>,
+    /// Prefetching: memory latency in cycles (up to a million).
+    #[arg(
+        long,
+        value_name = "CYCLES",
+        default_value_t = 200,
+        requires = "prefetch",
+        value_parser = clap::value_parser!(u32).range(0..=1_000_000)
+    )]
+    latency: u32,
+    /// Prefetching: cycles per line request (the memory's bandwidth), at least 1.
+    #[arg(
+        long,
+        value_name = "CYCLES",
+        default_value_t = 1,
+        requires = "prefetch",
+        value_parser = clap::value_parser!(u32).range(1..)
+    )]
+    request_cycles: u32,
 }
 
 fn parse_size_arg(s: &str) -> Result<u64, String> {
@@ -172,9 +226,13 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         Ok(o) => o,
         Err(e) => return usage(format!("{e:#}")),
     };
-    let (chain, blocks) = args.read.load_chain(&args.texture)?;
-    let sampler = Sampler::new(&chain, options)?;
-    let layout = ChainLayout::for_sampler_stored(&chain, &sampler, args.layout, blocks);
+    let model = match model(&args) {
+        Ok(m) => m,
+        Err(m) => return usage(m),
+    };
+    let texture = texture_for(&args, &[options])?;
+    let sampler = Sampler::shared(texture.chain.clone(), options)?;
+    let layout = texture.layout(&sampler, args.layout);
     let setup = SceneSetup {
         sampler: &sampler,
         layout: &layout,
@@ -215,25 +273,26 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
             };
             parvo::io::atomic::write(p, |w| {
                 writeln!(w, "{header}").map_err(io_err)?;
-                setup.simulate(
+                setup.run(
                     &l1,
                     l2.as_ref(),
-                    &mut |a| write_trace_line(w, unpack(a).0).map_err(io_err),
+                    &model,
+                    Some(&mut |a| write_trace_line(w, unpack(a).0).map_err(io_err)),
                     &progress,
                 )
             })?
         }
-        None => setup.simulate(&l1, l2.as_ref(), &mut |_| Ok(()), &progress)?,
+        None => setup.run(&l1, l2.as_ref(), &model, None, &progress)?,
     };
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
     let report = Report {
-        what: scene_what(&args, &chain, blocks, &sampler, &layout),
+        what: scene_what(&args, &texture, &sampler, &layout),
         l1,
         l2,
         run: stats,
-        levels: chain.len(),
+        levels: texture.chain.len(),
     };
     if args.json {
         println!("{}", report.json());
@@ -246,8 +305,7 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
 /// What a scene run measured, the report's first line.
 fn scene_what(
     args: &CachesimArgs,
-    chain: &parvo::MipChain,
-    blocks: Option<parvo::compress::BlockFormat>,
+    texture: &CacheTexture,
     sampler: &Sampler,
     layout: &ChainLayout,
 ) -> String {
@@ -256,23 +314,68 @@ fn scene_what(
         args.scene,
         args.size,
         args.texture,
-        match blocks {
+        match texture.blocks {
             Some(b) => format!(
                 "{b} blocks, {} bytes per 4x4 block (a texel read fetches its block; the \
                  layout counts blocks)",
                 layout.texel()
             ),
-            None => format!(
-                "{}, {} bytes per texel",
-                chain.levels()[0].format(),
-                layout.texel()
-            ),
+            None => format!("{}, {} bytes per texel", texture.format(), layout.texel()),
         },
-        chain.len(),
+        texture.chain.len(),
         sampler.options().name(),
         args.layout,
         args.order
     )
+}
+
+/// The texture unit the arguments ask for, or the usage error.
+fn model(args: &CachesimArgs) -> std::result::Result<Model, String> {
+    if args.quads && args.trace_out.is_some() {
+        return Err(
+            "--trace-out writes every texel read; with --quads the cache sees merged requests, \
+             which a replay of that trace would not"
+                .into(),
+        );
+    }
+    let prefetch: Vec<Timing> = args
+        .prefetch
+        .iter()
+        .map(|&depth| Timing {
+            depth,
+            latency: args.latency,
+            request_cycles: args.request_cycles,
+        })
+        .collect();
+    // The arguments' ranges are the model's: this only guards them.
+    for t in &prefetch {
+        t.validate().map_err(|e| super::words(e).to_string())?;
+    }
+    Ok(Model {
+        quads: args.quads,
+        prefetch,
+    })
+}
+
+/// The texture the runs read: for a built-in texture whose values none
+/// of `filters` reads (and no --color override), its sizes and format
+/// alone ([`CacheTexture::builtin`]: no texel generated or mip-mapped);
+/// otherwise the texture as loaded.
+fn texture_for(args: &CachesimArgs, filters: &[SamplerOptions]) -> Result<CacheTexture> {
+    let spec = &args.texture;
+    let values = filters.iter().any(shape::reads_depend_on_values);
+    if !values && parvo::builtin::is_builtin(spec) && args.read.color == ColorArg::Auto {
+        return parvo::builtin::parse(spec)
+            .and_then(|(_, size)| {
+                let n = size as u64;
+                parvo::io::Limits::default().check(n, n, n * n * 4)
+            })
+            .and_then(|()| CacheTexture::builtin(spec))
+            .map_err(super::with_hint)
+            .with_context(|| format!("cannot read texture `{spec}`"));
+    }
+    let (chain, blocks) = args.read.load_chain(spec)?;
+    Ok(CacheTexture::loaded(Arc::new(chain), blocks))
 }
 
 fn sampler_options(args: &CachesimArgs, name: &str) -> Result<SamplerOptions> {
@@ -306,6 +409,10 @@ fn trace_mode(
         eprintln!("parvo: --access-bytes must be at least 1");
         return Ok(ExitCode::from(2));
     }
+    if args.quads || !args.prefetch.is_empty() {
+        eprintln!("parvo: --quads and --prefetch need a scene's pixels; an address trace has none");
+        return Ok(ExitCode::from(2));
+    }
     let mut sim = Simulator::new(l1, l2, AddressSpace::Any, true)?;
     let n = if path.as_os_str() == "-" {
         read_trace(std::io::stdin().lock(), &mut |a| {
@@ -326,11 +433,7 @@ fn trace_mode(
         ),
         l1: *l1,
         l2: l2.copied(),
-        run: RunStats {
-            stats: sim.into_stats(),
-            pixels: 0,
-            reads: n,
-        },
+        run: RunStats::plain(sim.into_stats(), 0, n),
         levels: 0,
     };
     if args.json {
@@ -411,7 +514,83 @@ impl Report {
             o["cache"] = cfg.to_string().into();
             v["l2"] = o;
         }
+        if let Some(q) = self.run.quads {
+            let per_pixel = |n: u64| n as f64 / pixels.max(1) as f64;
+            v["quads"] = q.into();
+            v["line_requests"] = s.total.accesses.into();
+            v["line_requests_per_pixel"] = per_pixel(s.total.accesses).into();
+            v["line_fetches"] = s.total.misses.into();
+            v["line_fetches_per_pixel"] = per_pixel(s.total.misses).into();
+        }
+        if !self.run.prefetch.is_empty() {
+            v["prefetch"] = self
+                .run
+                .prefetch
+                .iter()
+                .map(prefetch_json)
+                .collect::<Vec<_>>()
+                .into();
+        }
         v
+    }
+
+    /// The quads' lines and the prefetch table, when the run has them.
+    fn model_table(&self, t: &mut String) {
+        use std::fmt::Write as _;
+        let s = &self.run.stats.total;
+        let px = self.run.pixels.max(1) as f64;
+        if let Some(q) = self.run.quads {
+            let _ = writeln!(
+                t,
+                "quads {q}: line requests {} ({:.2} per pixel; a quad's reads of one line are one \
+                 request), line fetches {} ({:.2} per pixel)",
+                s.accesses,
+                s.accesses as f64 / px,
+                s.misses,
+                s.misses as f64 / px
+            );
+        }
+        let Some(first) = self.run.prefetch.first() else {
+            return;
+        };
+        let _ = writeln!(
+            t,
+            "prefetching unit: {} {}, memory latency {} cycles, a line request every {} cycle(s), \
+             one fragment filtered per cycle; blocking cache (FIFO 0) {} cycles",
+            first.fragments,
+            if self.run.quads.is_some() {
+                "quads"
+            } else {
+                "pixels"
+            },
+            first.timing.latency,
+            first.timing.request_cycles,
+            first.blocking_cycles
+        );
+        let _ = writeln!(
+            t,
+            "{:>6} {:>12} {:>12} {:>10} {:>17} {:>15} {:>11}",
+            "fifo",
+            "cycles",
+            "stall cycles",
+            "stalled",
+            "stall-free hits",
+            "latency hidden",
+            "efficiency"
+        );
+        for p in &self.run.prefetch {
+            let _ = writeln!(
+                t,
+                "{:>6} {:>12} {:>12} {:>10} {:>16.2}% {:>14.1}% {:>10.1}%",
+                p.timing.depth,
+                p.cycles,
+                p.stall_cycles(),
+                p.stalled_fragments,
+                p.stall_free_hit_rate() * 100.0,
+                p.latency_hidden() * 100.0,
+                p.efficiency() * 100.0
+            );
+        }
     }
 
     fn table(&self) -> String {
@@ -482,8 +661,27 @@ impl Report {
                 "-".into()
             }
         );
+        self.model_table(&mut t);
         t
     }
+}
+
+fn prefetch_json(p: &PrefetchStats) -> serde_json::Value {
+    serde_json::json!({
+        "fifo_depth": p.timing.depth,
+        "latency_cycles": p.timing.latency,
+        "request_cycles": p.timing.request_cycles,
+        "fragments": p.fragments,
+        "line_requests": p.requests,
+        "line_fetches": p.misses,
+        "cycles": p.cycles,
+        "stall_cycles": p.stall_cycles(),
+        "stalled_fragments": p.stalled_fragments,
+        "stall_free_hit_rate": p.stall_free_hit_rate(),
+        "latency_hidden": p.latency_hidden(),
+        "efficiency": p.efficiency(),
+        "blocking_cycles": p.blocking_cycles,
+    })
 }
 
 fn human(b: u64) -> String {
@@ -535,14 +733,22 @@ fn sweep_mode(args: &CachesimArgs) -> Result<ExitCode> {
             return Ok(ExitCode::from(2));
         }
     };
+    let model = match model(args) {
+        Ok(m) => m,
+        Err(m) => {
+            eprintln!("parvo: {m}");
+            return Ok(ExitCode::from(2));
+        }
+    };
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let (chain, blocks) = args.read.load_chain(&args.texture)?;
+    let options: Vec<SamplerOptions> = settings.filters.iter().map(|f| f.1).collect();
+    let texture = texture_for(args, &options)?;
     let bar = progress_bar(args)?;
     if let Some(b) = &bar {
         b.set_length(settings.configurations() as u64);
         b.set_message("configurations");
     }
-    let rows = sweep(&chain, blocks, &settings, &|| {
+    let rows = sweep_with(&texture, &settings, &model, &|| {
         if let Some(b) = &bar {
             b.inc(1);
         }

@@ -70,6 +70,9 @@ pub(crate) trait Filters: Copy {
     const SAME: bool;
     /// True for [`Lin`] (bilinear for both), which has SIMD paths.
     const LINEAR: bool = false;
+    /// True for [`Near`] (nearest for both), which has an isotropic SIMD
+    /// path.
+    const NEAREST: bool = false;
     /// Run the magnification (`magnify`) or minification filter on level
     /// `li`.
     #[allow(clippy::too_many_arguments)]
@@ -102,6 +105,7 @@ pub(crate) struct MagMin {
 
 impl Filters for Near {
     const SAME: bool = true;
+    const NEAREST: bool = true;
     #[inline(always)]
     fn run<P: Pixel, S: TexelSink>(
         self,

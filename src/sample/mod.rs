@@ -679,20 +679,25 @@ impl Sampler {
 
     /// Whether lookups without a tracing sink take the AVX-512 path: the
     /// bilinear, trilinear and footprint-assembly lookups (linear
-    /// magnification and minification, mip mode nearest or linear) on a
+    /// magnification and minification, mip mode nearest or linear) and
+    /// the isotropic nearest ones (nearest magnification and
+    /// minification, mip mode nearest or linear) on a
     /// CPU with AVX-512 F, BW, DQ, VL and VBMI, unless `PARVO_NO_AVX` is
     /// set. The results are the same either way, bit for bit; traced
     /// lookups always take the portable path.
     pub fn uses_simd(&self) -> bool {
         #[cfg(target_arch = "x86_64")]
         {
-            use TexelFilter::Linear;
+            use TexelFilter::{Linear, Nearest};
             let o = &self.options;
-            let kernel = matches!(self.kernel, Kernel::Isotropic | Kernel::Texel);
-            kernel
-                && (o.mag, o.min) == (Linear, Linear)
-                && o.mip != MipMode::None
-                && self.simd.is_some()
+            let filters = match self.kernel {
+                Kernel::Isotropic => {
+                    (o.mag, o.min) == (Linear, Linear) || (o.mag, o.min) == (Nearest, Nearest)
+                }
+                Kernel::Texel => (o.mag, o.min) == (Linear, Linear),
+                _ => false,
+            };
+            filters && o.mip != MipMode::None && self.simd.is_some()
         }
         #[cfg(not(target_arch = "x86_64"))]
         false
@@ -999,6 +1004,22 @@ impl Sampler {
                 } else {
                     simd::isotropic::<P, MIP>(c, table, a, lod, o, queries, out);
                 }
+            }
+            return;
+        }
+        // Nearest lookups go 16 at a time (see `simd::nearest`).
+        #[cfg(target_arch = "x86_64")]
+        if let Some(table) = &self.simd
+            && !S::TRACES
+            && F::NEAREST
+            && !ANISO
+            && MIP != trilinear::MIP_NONE
+            && queries.len() >= 16
+        {
+            // SAFETY: as above.
+            #[allow(unsafe_code)]
+            unsafe {
+                simd::nearest::<P, MIP>(c, table, a, lod, o, queries, out);
             }
             return;
         }

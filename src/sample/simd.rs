@@ -1,7 +1,9 @@
 //! AVX-512 lookups for the bilinear and trilinear filters and footprint
 //! assembly (linear magnification and minification filters, mip mode
-//! nearest or linear, no texel tracing), chosen at run time on CPUs with
-//! AVX-512 F, BW, DQ, VL and VBMI. `PARVO_NO_AVX=1` turns them off.
+//! nearest or linear, no texel tracing), and for the isotropic nearest
+//! filter ([`nearest`]: one texel per lookup, no blend within a level),
+//! chosen at run time on CPUs with AVX-512 F, BW, DQ, VL and VBMI.
+//! `PARVO_NO_AVX=1` turns them off.
 //!
 //! # Same answers, bit for bit
 //! These paths perform the portable code's operations on the same values
@@ -54,7 +56,7 @@
 use std::arch::x86_64::*;
 
 use super::aniso::Setup;
-use super::bilinear::Lin;
+use super::bilinear::{Lin, Near};
 use super::fetch::{Addressing, Chain, Lut8, Pixel};
 use super::footprint::{LOG2_BITS, LOG2_POLY, Lod, Plan, UNBOUNDED_TEXELS};
 use super::trace::NoTrace;
@@ -201,22 +203,48 @@ fn blocks<P: Pixel>(ls: &Levels, lvl: __m512i, u: __m512d, v: __m512d) -> Blocks
     // replaced before use). Bytes from texels: a shift for the sizes that
     // are powers of two, a multiply for 3, 6 and 12.
     let k = _mm512_add_epi64(_mm512_mul_epu32(j0, w), i0);
-    let size = std::mem::size_of::<P>();
-    let bytes = |n: __m512i| {
-        if size.is_power_of_two() {
-            _mm512_sllv_epi64(n, _mm512_set1_epi64(size.trailing_zeros() as i64))
-        } else {
-            _mm512_mul_epu32(n, _mm512_set1_epi64(size as i64))
-        }
-    };
-    let top = _mm512_add_epi64(look_epi64(&ls.base, lvl), bytes(k));
+    let top = _mm512_add_epi64(look_epi64(&ls.base, lvl), bytes::<P>(k));
     Blocks {
         top,
-        bot: _mm512_add_epi64(top, bytes(w)),
+        bot: _mm512_add_epi64(top, bytes::<P>(w)),
         al: _mm512_cvtpd_ps(_mm512_sub_pd(x, fx)),
         be: _mm512_cvtpd_ps(_mm512_sub_pd(y, fy)),
         inside,
     }
+}
+
+/// Bytes of `n` texels (below 2^32) per lane: a shift for the sizes that
+/// are powers of two, a multiply for 3, 6 and 12.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn bytes<P: Pixel>(n: __m512i) -> __m512i {
+    let size = std::mem::size_of::<P>();
+    if size.is_power_of_two() {
+        _mm512_sllv_epi64(n, _mm512_set1_epi64(size.trailing_zeros() as i64))
+    } else {
+        _mm512_mul_epu32(n, _mm512_set1_epi64(size as i64))
+    }
+}
+
+/// Where the texels of 8 nearest lookups lie on their levels `lvl`:
+/// `bilinear::nearest`'s fast path, lane-wise. The address of texel
+/// `(floor(u·w), floor(v·h))` ([`ZEROS`] for lanes outside their level)
+/// and the lanes inside.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+fn texels<P: Pixel>(ls: &Levels, lvl: __m512i, u: __m512d, v: __m512d) -> (__m512i, u8) {
+    let (w, h) = (look_epi64(&ls.w, lvl), look_epi64(&ls.h, lvl));
+    // floor as in `blocks` (NaN, ±∞ and huge values: i64::MIN, outside).
+    const FLOOR: i32 = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
+    let i = _mm512_cvt_roundpd_epi64::<FLOOR>(_mm512_mul_pd(u, _mm512_cvtepi64_pd(w)));
+    let j = _mm512_cvt_roundpd_epi64::<FLOOR>(_mm512_mul_pd(v, _mm512_cvtepi64_pd(h)));
+    let inside = _mm512_cmplt_epu64_mask(i, w) & _mm512_cmplt_epu64_mask(j, h);
+    // Inside lanes have 0 ≤ i < w < 2^32 and 0 ≤ j: j·w by a 32 × 32-bit
+    // multiply, as in `blocks`.
+    let k = _mm512_add_epi64(_mm512_mul_epu32(j, w), i);
+    let at = _mm512_add_epi64(look_epi64(&ls.base, lvl), bytes::<P>(k));
+    let zeros = _mm512_set1_epi64(ZEROS.as_ptr().expose_provenance() as i64);
+    (_mm512_mask_blend_epi64(inside, zeros, at), inside)
 }
 
 /// 64 zero bytes that lanes outside their level read instead of texels
@@ -974,6 +1002,150 @@ fn portable<P: Pixel, const MIP: u8>(
     let p = trilinear::plan::<Lin, MIP>(lod, o, q);
     let (u, v) = lod.reduce(q);
     trilinear::probe(c, Lin, &p, u, v, a, &mut NoTrace)
+}
+
+/// Isotropic nearest lookups (`Near` filters, mip mode `MIP` nearest or
+/// linear) of `queries` into `out`: what `trilinear::plan` and
+/// `trilinear::probe` compute, 16 queries at a time. The plans and texel
+/// addresses of 8 lanes at once (the plans as [`isotropic`]'s, the texel
+/// as `bilinear::nearest`'s fast path), then the 16 texels read: packed
+/// RGBA8 ones decoded at once in registers ([`decode_rgba8`]), the other
+/// storages by `Pixel::decode` (the portable code's decode); with mip
+/// mode linear, the lanes that blend a second level blend its texel by
+/// `fetch::lerp` as the portable code does. Lanes outside their level, a
+/// plan this cannot compute and the last partial 16 take the portable
+/// path.
+///
+/// # Safety
+/// As [`isotropic`].
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+pub(crate) unsafe fn nearest<P: Pixel, const MIP: u8>(
+    c: &Chain<P>,
+    table: &LevelTable,
+    a: &Addressing,
+    lod: &Lod,
+    opts: &SamplerOptions,
+    queries: &[Query],
+    out: &mut [[f32; 4]],
+) {
+    let ls = Levels::new(table);
+    let (q16s, _) = queries.as_chunks::<16>();
+    let whole = q16s.len() * 16;
+    let (o16s, _) = out.as_chunks_mut::<16>();
+    for (q16, o16) in q16s.iter().zip(o16s.iter_mut()) {
+        let mut at = [0u64; 16];
+        let mut at2 = [0u64; 16];
+        let mut delta = [0f32; 16];
+        let (mut fast, mut two) = (0u16, 0u16);
+        for (h, q8) in q16.as_chunks::<8>().0.iter().enumerate() {
+            let f = fields(q8);
+            let (hi, lo, d, ok) = plans::<MIP>(lod, opts, &f);
+            let u = reduce_lanes(f[0], lod.wrap_u);
+            let v = reduce_lanes(f[1], lod.wrap_v);
+            let (t, inside) = texels::<P>(&ls, hi, u, v);
+            // Coordinates of 2^51 and more take the portable path: there
+            // `Lod::reduce` saturates (`fast_floor`) where `reduce_lanes`
+            // is exact, and the bilinear paths' accident (an exact 0 is
+            // outside a 2×2 block) does not protect a single texel.
+            let limit = _mm512_set1_pd(REDUCE_EXACT);
+            let small = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(f[0]), limit)
+                & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(f[1]), limit);
+            let mut fast8 = ok & inside & small;
+            // SAFETY: 64-byte stores of 8 entries inside the 16-entry
+            // arrays (h is 0 or 1).
+            unsafe { _mm512_storeu_epi64(at[8 * h..].as_mut_ptr().cast(), t) };
+            if MIP == MIP_LINEAR {
+                let two8 = blends_two(d, hi, lo) & fast8;
+                if two8 != 0 {
+                    let (t2, inside2) = texels::<P>(&ls, lo, u, v);
+                    fast8 &= !two8 | inside2;
+                    two |= ((two8 & fast8) as u16) << (8 * h);
+                    // SAFETY: as above.
+                    unsafe {
+                        _mm512_storeu_epi64(at2[8 * h..].as_mut_ptr().cast(), t2);
+                        _mm256_storeu_ps(delta[8 * h..].as_mut_ptr(), d);
+                    }
+                }
+            }
+            fast |= (fast8 as u16) << (8 * h);
+        }
+        // SAFETY: every address is a texel inside its level or `ZEROS`
+        // (`texels`), and the texels are at most 16 bytes (`fits`).
+        unsafe { texels16::<P>(c, &at, o16) };
+        if MIP == MIP_LINEAR && two != 0 {
+            for (i, o) in o16.iter_mut().enumerate() {
+                if two >> i & 1 != 0 {
+                    // SAFETY: a lane in `two` has its second texel inside
+                    // its level.
+                    let t2 = unsafe { read::<P>(at2[i]) }.decode(&c.lut);
+                    *o = super::fetch::lerp(*o, t2, delta[i]);
+                }
+            }
+        }
+        if fast != 0xFFFF {
+            for (i, (q, o)) in q16.iter().zip(o16.iter_mut()).enumerate() {
+                if fast >> i & 1 == 0 {
+                    *o = portable_nearest::<P, MIP>(c, a, lod, opts, q);
+                }
+            }
+        }
+    }
+    for (q, o) in queries[whole..].iter().zip(&mut out[whole..]) {
+        *o = portable_nearest::<P, MIP>(c, a, lod, opts, q);
+    }
+}
+
+/// Below this magnitude `reduce_lanes` equals `Lod::reduce` (both floors
+/// exact): 2^51.
+const REDUCE_EXACT: f64 = 2_251_799_813_685_248.0;
+
+/// The 16 texels at `at`, decoded into `out`: packed RGBA8 in registers
+/// (the codes loaded transposed, so that each register holds 4
+/// consecutive results), the others by `Pixel::decode`.
+///
+/// # Safety
+/// Every address satisfies [`read`] for `size_of::<P>()` bytes.
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+unsafe fn texels16<P: Pixel>(c: &Chain<P>, at: &[u64; 16], out: &mut [[f32; 4]; 16]) {
+    if let Some(lut) = P::packed(&c.lut) {
+        // `decode_rgba8` puts the code of 32-bit lane 4j + r into group j
+        // of register r: lane 4j + r takes texel 4r + j, and register r
+        // then holds texels 4r … 4r + 3 in order.
+        let mut codes = [0u32; 16];
+        for (l, code) in codes.iter_mut().enumerate() {
+            let (j, r) = (l / 4, l % 4);
+            // SAFETY: the caller's contract (`fits` makes packed texels 4
+            // bytes).
+            *code = unsafe { read::<u32>(at[4 * r + j]) };
+        }
+        // SAFETY: a 64-byte load of the 16 codes.
+        let codes = unsafe { _mm512_loadu_epi32(codes.as_ptr().cast()) };
+        let d = decode_rgba8(lut, codes);
+        for (r, d) in d.into_iter().enumerate() {
+            // SAFETY: a 64-byte store into 4 RGBA values.
+            unsafe { _mm512_storeu_ps(out[4 * r..].as_mut_ptr().cast(), d) };
+        }
+    } else {
+        for (o, &t) in out.iter_mut().zip(at) {
+            // SAFETY: the caller's contract.
+            *o = unsafe { read::<P>(t) }.decode(&c.lut);
+        }
+    }
+}
+
+/// One isotropic nearest lookup the portable way.
+#[inline(never)]
+fn portable_nearest<P: Pixel, const MIP: u8>(
+    c: &Chain<P>,
+    a: &Addressing,
+    lod: &Lod,
+    o: &SamplerOptions,
+    q: &Query,
+) -> [f32; 4] {
+    let p = trilinear::plan::<Near, MIP>(lod, o, q);
+    let (u, v) = lod.reduce(q);
+    trilinear::probe(c, Near, &p, u, v, a, &mut NoTrace)
 }
 
 /// [`Lod::reduce`] on 8 lanes: `x − floor(x)` (repeat) or

@@ -9,7 +9,9 @@
 //! queries ([`Scene::query`]) take the value at the pixel's centre and the
 //! derivatives as central differences over one pixel (what a rasterizer's
 //! 2×2 quad differences approximate). Scenes whose scale is given in
-//! texels (zoom, rotate) need the level-0 texture size.
+//! texels (zoom, rotate) need the level-0 texture size. A [`View`] is a
+//! scene set up for one frame (its camera's constants computed once), with
+//! the same values.
 //!
 //! - [`plane`]: a pinhole camera above a textured ground plane (footprints
 //!   grow and stretch towards the horizon);
@@ -25,6 +27,7 @@ pub mod order;
 pub mod plane;
 pub mod reference;
 pub mod render;
+pub mod view;
 
 use std::fmt;
 use std::str::FromStr;
@@ -35,6 +38,7 @@ use crate::sample::Query;
 pub use order::RasterOrder;
 pub use plane::Plane;
 pub use reference::{PixelFilter, Reference};
+pub use view::View;
 
 /// A frame size in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -217,48 +221,19 @@ impl FromStr for Scene {
 }
 
 impl Scene {
+    /// This scene set up for `frame` and a level-0 texture of `tex` texels:
+    /// the per-frame constants computed once, for a frame's worth of
+    /// [`View::query`] calls (same values as [`Scene::query`]).
+    pub fn view(&self, frame: Frame, tex: (u32, u32)) -> View {
+        View::new(self, frame, tex, true)
+    }
+
     /// Texture coordinate of the continuous screen position `(x, y)` (in
     /// pixels, row 0 at the top), for a level-0 texture of `tex` texels;
-    /// `None` where the scene shows no texture.
+    /// `None` where the scene shows no texture. (Each call sets the scene
+    /// up for the frame; [`Scene::view`] does it once.)
     pub fn uv(&self, frame: Frame, tex: (u32, u32), x: f64, y: f64) -> Option<(f64, f64)> {
-        let (w, h) = (frame.width as f64, frame.height as f64);
-        let (tw, th) = (tex.0.max(1) as f64, tex.1.max(1) as f64);
-        match self {
-            Scene::Plane(p) => p.uv(frame, x, y),
-            Scene::Tunnel(t) => {
-                let tan = (t.fov_y * 0.5).tan();
-                let nx = (x / w * 2.0 - 1.0) * tan * (w / h);
-                let ny = (1.0 - y / h * 2.0) * tan;
-                let r = (nx * nx + ny * ny).sqrt();
-                if r < 1e-12 {
-                    return None;
-                }
-                let z = 1.0 / r;
-                if z > t.max_distance {
-                    return None;
-                }
-                let angle = ny.atan2(nx) / std::f64::consts::TAU + 0.5;
-                Some((angle * t.repeats_around, z * t.v_per_unit))
-            }
-            Scene::Zoom(z) => {
-                let k = (z.lod_right - z.lod_left) / w;
-                let s = (z.lod_left + k * x).exp2();
-                let u = if k.abs() < 1e-15 {
-                    s * x
-                } else {
-                    (s - z.lod_left.exp2()) / (k * std::f64::consts::LN_2)
-                };
-                Some((u / tw, 0.5 + (y - h * 0.5) * s / th))
-            }
-            Scene::Rotate(r) => {
-                let (sn, cs) = r.degrees.to_radians().sin_cos();
-                let (dx, dy) = (x - w * 0.5, y - h * 0.5);
-                Some((
-                    0.5 + (cs * dx - sn * dy) * r.scale / tw,
-                    0.5 + (sn * dx + cs * dy) * r.scale / th,
-                ))
-            }
-        }
+        View::new(self, frame, tex, false).uv(x, y)
     }
 
     /// The query of pixel `(px, py)`: the coordinate at its centre and the
@@ -271,32 +246,7 @@ impl Scene {
     /// The query of a pixel centred at `(x, y)` (a pixel's centre plus a
     /// camera offset, for the flicker metric).
     pub fn query_at(&self, frame: Frame, tex: (u32, u32), x: f64, y: f64) -> Option<Query> {
-        let at = |x: f64, y: f64| self.uv(frame, tex, x, y);
-        let c = at(x, y)?;
-        let (l, r) = (at(x - 0.5, y)?, at(x + 0.5, y)?);
-        let (t, b) = (at(x, y - 0.5)?, at(x, y + 0.5)?);
-        // The tunnel's u wraps around the circle: difference across the
-        // seam by the short way.
-        let period = match self {
-            Scene::Tunnel(t) => Some(t.repeats_around),
-            _ => None,
-        };
-        let d = |a: f64, b: f64| match period {
-            Some(p) => {
-                let mut v = b - a;
-                v -= (v / p).round() * p;
-                v
-            }
-            None => b - a,
-        };
-        Some(Query::new(
-            c.0 as f32,
-            c.1 as f32,
-            d(l.0, r.0) as f32,
-            (r.1 - l.1) as f32,
-            d(t.0, b.0) as f32,
-            (b.1 - t.1) as f32,
-        ))
+        View::new(self, frame, tex, false).query_at(x, y)
     }
 
     /// Every pixel that shows texture, in `order`, with its query.
@@ -306,9 +256,10 @@ impl Scene {
         tex: (u32, u32),
         order: RasterOrder,
     ) -> Vec<((u32, u32), Query)> {
+        let view = self.view(frame, tex);
         order
             .pixels(frame)
-            .filter_map(|(px, py)| self.query(frame, tex, px, py).map(|q| ((px, py), q)))
+            .filter_map(|(px, py)| view.query(px, py).map(|q| ((px, py), q)))
             .collect()
     }
 }

@@ -117,6 +117,45 @@ fn hilbert_d2xy(n: u64, d: u64) -> (u32, u32) {
 }
 
 impl RasterOrder {
+    /// [`RasterOrder::pixels`] collected (with plain loops for `scanline`
+    /// and `tiled:N`, the common orders).
+    pub fn pixel_list(self, frame: Frame) -> Vec<(u32, u32)> {
+        let (w, h) = (frame.width, frame.height);
+        let mut v = Vec::with_capacity(frame.pixels() as usize);
+        match self {
+            RasterOrder::Scanline => {
+                for y in 0..h {
+                    v.extend((0..w).map(|x| (x, y)));
+                }
+            }
+            RasterOrder::Tiled(n) => {
+                let n = n.max(1);
+                for y0 in (0..h).step_by(n as usize) {
+                    for x0 in (0..w).step_by(n as usize) {
+                        for y in y0..(y0 + n).min(h) {
+                            v.extend((x0..(x0 + n).min(w)).map(|x| (x, y)));
+                        }
+                    }
+                }
+            }
+            _ => v.extend(self.pixels(frame)),
+        }
+        v
+    }
+
+    /// The 2×2 quads of `frame` in this order: quad `(qx, qy)` holds pixels
+    /// `2qx ..= 2qx + 1` × `2qy ..= 2qy + 1` (those inside the frame), and
+    /// the order runs over the ⌈W/2⌉ × ⌈H/2⌉ grid of quads, `tiled:N` in
+    /// tiles of ⌈N/2⌉ quads (N pixels, rounded up to whole quads).
+    pub fn quads(self, frame: Frame) -> Vec<(u32, u32)> {
+        let grid = Frame::new(frame.width.div_ceil(2), frame.height.div_ceil(2));
+        let order = match self {
+            RasterOrder::Tiled(n) => RasterOrder::Tiled(n.div_ceil(2)),
+            other => other,
+        };
+        order.pixel_list(grid)
+    }
+
     /// Every pixel of `frame` exactly once, in this order.
     pub fn pixels(self, frame: Frame) -> Box<dyn Iterator<Item = (u32, u32)> + Send> {
         let (w, h) = (frame.width, frame.height);

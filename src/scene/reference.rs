@@ -151,6 +151,7 @@ impl Reference {
         progress: &(dyn Fn(u32) + Sync),
     ) -> Vec<Option<[f32; 4]>> {
         let tex = level0.chain().level_size(0).unwrap_or((1, 1));
+        let view = scene.view(frame, tex);
         let done = std::sync::atomic::AtomicU32::new(0);
         let rows: Vec<Vec<Option<[f32; 4]>>> = (0..frame.height)
             .into_par_iter()
@@ -161,7 +162,7 @@ impl Reference {
                 let mut out: Vec<[f32; 4]> = Vec::new();
                 for px in 0..frame.width {
                     let (cx, cy) = (px as f64 + 0.5 + offset.0, py as f64 + 0.5 + offset.1);
-                    let Some(q) = scene.query_at(frame, tex, cx, cy) else {
+                    let Some(q) = view.query_at(cx, cy) else {
                         row.push(None);
                         continue;
                     };
@@ -177,7 +178,7 @@ impl Reference {
                             if w <= 0.0 {
                                 continue;
                             }
-                            if let Some((u, v)) = scene.uv(frame, tex, cx + dx, cy + dy) {
+                            if let Some((u, v)) = view.uv(cx + dx, cy + dy) {
                                 qs.push(Query::new(u as f32, v as f32, 0.0, 0.0, 0.0, 0.0));
                                 ws.push(w);
                             }

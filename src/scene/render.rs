@@ -24,16 +24,13 @@ pub fn queries(
     tex: (u32, u32),
     offset: (f64, f64),
 ) -> Vec<Option<Query>> {
+    let view = scene.view(frame, tex);
+    let view = &view;
     (0..frame.height)
         .into_par_iter()
         .flat_map_iter(|py| {
             (0..frame.width).map(move |px| {
-                scene.query_at(
-                    frame,
-                    tex,
-                    px as f64 + 0.5 + offset.0,
-                    py as f64 + 0.5 + offset.1,
-                )
+                view.query_at(px as f64 + 0.5 + offset.0, py as f64 + 0.5 + offset.1)
             })
         })
         .collect()
