@@ -38,6 +38,8 @@ pub mod kernel;
 pub mod nan;
 pub mod normal;
 pub mod roughness;
+mod sep_fast;
+mod sep_simd;
 pub mod separable;
 mod srgb_simd;
 pub mod stream;
@@ -455,7 +457,10 @@ fn reduce_working(
 ) -> Result<(Texture, Option<Texels>, bool)> {
     let fast = options
         .fast_paths
-        .then(|| fast::try_reduce_linear(src, w, h, options, encode))
+        .then(|| {
+            fast::try_reduce_linear(src, w, h, options, encode)
+                .or_else(|| sep_fast::try_reduce_linear(src, w, h, options, encode))
+        })
         .flatten();
     let (v, coded, finite) = match fast {
         Some(r) => (r.linear, r.stored, r.finite),

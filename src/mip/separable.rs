@@ -117,12 +117,15 @@ pub(crate) fn reduce_linear_checked(
 /// bit.
 pub(crate) struct Reducer {
     wx: AxisWeights,
-    wy: AxisWeights,
+    pub(crate) wy: AxisWeights,
     runs: Vec<Option<u32>>,
-    ch: usize,
-    sw: usize,
+    pub(crate) ch: usize,
+    pub(crate) sw: usize,
     /// The straight alpha channel, if the texels have one.
-    straight: Option<usize>,
+    pub(crate) straight: Option<usize>,
+    /// The fast row kernel's expanded weights ([`Reducer::fast`]); `None`:
+    /// the plain kernel, the reference.
+    ex: Option<super::sep_simd::Expanded>,
 }
 
 impl Reducer {
@@ -155,6 +158,25 @@ impl Reducer {
             ch: fmt.channels as usize,
             sw: sw as usize,
             straight,
+            ex: None,
+        }
+    }
+
+    /// The same reduction with the fast row kernel ([`super::sep_simd`]):
+    /// the same values up to the order of the sums.
+    pub(crate) fn fast(mut self) -> Reducer {
+        self.ex = Some(super::sep_simd::Expanded::new(&self.wx, self.ch));
+        self
+    }
+
+    /// Filter the weighted `rows` into destination row `dst` with this
+    /// reducer's kernel (plain or fast).
+    fn filter(&self, rows: &[(&[f32], f32)], tmp: &mut [f32], dst: &mut [f32]) {
+        match &self.ex {
+            Some(ex) => {
+                super::sep_simd::filter_row(rows, tmp, dst, &self.wx, &self.runs, ex, self.ch)
+            }
+            None => filter_row(rows, tmp, dst, &self.wx, &self.runs, self.ch),
         }
     }
 
@@ -162,7 +184,7 @@ impl Reducer {
     /// source rows `row_of(j)`; `alpha_of(j, a)` is `Some(bits)` when every
     /// texel of source row `j` has alpha (channel `a`) with these bits.
     /// Returns whether every value is finite.
-    fn row<'a>(
+    pub(crate) fn row<'a>(
         &self,
         y: usize,
         row_of: &impl Fn(u32) -> &'a [f32],
@@ -184,7 +206,7 @@ impl Reducer {
             None => {
                 let rows: Vec<(&[f32], f32)> =
                     taps.iter().map(|&(j, wt)| (row_of(j), wt)).collect();
-                filter_row(&rows, tmp, dst, &self.wx, &self.runs, ch);
+                self.filter(&rows, tmp, dst);
             }
             Some(a) => {
                 // Premultiply the rows this destination row reads.
@@ -204,7 +226,7 @@ impl Reducer {
                     .enumerate()
                     .map(|(k, &(_, wt))| (&scratch[k * n..][..n], wt))
                     .collect();
-                filter_row(&rows, tmp, dst, &self.wx, &self.runs, ch);
+                self.filter(&rows, tmp, dst);
                 unpremultiply(dst, a, ch, |x| {
                     unweighted(row_of, ch, &self.wx, &self.wy, x, y)
                 });
@@ -294,7 +316,7 @@ fn unpremultiply(dst: &mut [f32], a: usize, ch: usize, plain: impl Fn(usize) -> 
 /// every 8 values: the row is XORed 8 lanes at a time against the first
 /// alpha under a lane mask (this vectorises; the row is read from memory
 /// here for the first time, so it runs at memory speed).
-fn one_alpha(row: &[f32], ch: usize, a: usize) -> Option<u32> {
+pub(crate) fn one_alpha(row: &[f32], ch: usize, a: usize) -> Option<u32> {
     debug_assert!(ch == 2 || ch == 4);
     let first = row[a].to_bits();
     let mask: [u32; 8] = std::array::from_fn(|i| if i % ch == a { !0 } else { 0 });
@@ -317,7 +339,7 @@ fn one_alpha(row: &[f32], ch: usize, a: usize) -> Option<u32> {
 /// `PARVO_NO_AVX` turns it off for comparisons), else the portable code
 /// below, which is also the test reference for the AVX path (see the unit
 /// test at the end of this file).
-fn filter_row(
+pub(crate) fn filter_row(
     rows: &[(&[f32], f32)],
     tmp: &mut [f32],
     dst: &mut [f32],
