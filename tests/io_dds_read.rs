@@ -251,7 +251,7 @@ fn what_parvo_cannot_read_is_named() {
                 vec![0; 96],
             ]
             .concat(),
-            "cube maps",
+            "a cube map of six",
         ),
         (
             [

@@ -642,6 +642,13 @@ impl<'a> Banded<'a> {
         let reducer = super::separable::Reducer::new(
             f32fmt, w as u32, h as u32, w1 as u32, h1 as u32, options,
         );
+        // The fast row kernel where the whole-image build takes it
+        // (`sep_fast`), so both builds give the same levels.
+        let reducer = if super::sep_fast::takes(&base, options) {
+            reducer.fast()
+        } else {
+            reducer
+        };
         let mut lvl1: Vec<f32> = crate::mem::zeroed(w1 * h1 * ch);
         lvl1.par_chunks_mut(BAND_ROWS * w1 * ch)
             .enumerate()

@@ -3,10 +3,12 @@
 //! openexr-images' KernerEnvCube.exr and KernerEnvLatLong.exr) were
 //! silently flattened: `parvo mip` filtered a cube's six-face strip as one
 //! image, blending the faces into each other, and wrote it back as "Plain
-//! Texture" with periodic wrap. parvo cannot filter environment maps yet,
-//! so `mip` now refuses them with an error naming the kind, and `info`
-//! still reads them and says what they are. A maketx `.tx` environment
-//! map (TIFF) is treated the same.
+//! Texture" with periodic wrap. `mip` first refused them with an error
+//! naming the kind; since issue 30 it builds them as what they are (each
+//! cube face filtered on its own, the output marked as an environment)
+//! and refuses only outputs that cannot hold the kind. `info` reads them
+//! and says what they are. A maketx `.tx` environment map (TIFF) is still
+//! refused by `mip`.
 
 use crate::util::{TagValue, ok, parvo, s, write_tiff_u8};
 use exr::prelude::*;
@@ -36,16 +38,28 @@ fn env_exr(path: &std::path::Path, w: usize, h: usize, attrs: LayerAttributes) {
     Image::from_layer(layer).write().to_file(path).unwrap();
 }
 
-fn refused_by_mip_and_described_by_info(src: &std::path::Path, kind: &str) {
-    let out = src.with_extension("out.ktx2");
-    let r = parvo(&["mip", s(src), "-o", s(&out)]);
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert_eq!(r.status.code(), Some(1), "mip must refuse: {err}");
-    assert!(
-        err.contains(&format!("{kind} environment map")),
-        "the error names the kind: {err}"
+/// `mip` keeps the environment an environment (never a plain texture);
+/// an output that cannot hold its kind is refused, naming the kind, and
+/// nothing is written; `info` says what it is.
+fn not_flattened(src: &std::path::Path, kind: &str, id: &str, plain_out: &str) {
+    let out = src.with_extension("out.exr");
+    ok(&parvo(&["mip", s(src), "-o", s(&out)]));
+    let j: serde_json::Value =
+        serde_json::from_str(&ok(&parvo(&["info", "--json", s(&out)]))).unwrap();
+    assert_eq!(
+        j["kind"], id,
+        "the output is still a {kind} environment map"
     );
-    assert!(!out.exists(), "nothing is written");
+    let bad = src.with_extension(plain_out);
+    let r = parvo(&["mip", s(src), "-o", s(&bad)]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(
+        r.status.code(),
+        Some(1),
+        "a plain output must be refused: {err}"
+    );
+    assert!(err.contains("cannot store a"), "the error says why: {err}");
+    assert!(!bad.exists(), "nothing is written");
     let j: serde_json::Value =
         serde_json::from_str(&ok(&parvo(&["info", "--json", s(src)]))).unwrap();
     assert_eq!(j["status"], "ok");
@@ -57,7 +71,7 @@ fn refused_by_mip_and_described_by_info(src: &std::path::Path, kind: &str) {
 }
 
 #[test]
-fn a_cube_face_exr_is_refused_by_mip_and_described_by_info() {
+fn a_cube_face_exr_is_built_as_a_cube_map_and_described_by_info() {
     let dir = tempfile::tempdir().unwrap();
     let src = dir.path().join("cube.exr");
     let attrs = LayerAttributes {
@@ -65,7 +79,32 @@ fn a_cube_face_exr_is_refused_by_mip_and_described_by_info() {
         ..LayerAttributes::default()
     };
     env_exr(&src, 16, 96, attrs);
-    refused_by_mip_and_described_by_info(&src, "cube-face");
+    not_flattened(&src, "cube-face", "cube", "png");
+    // No face blends into another: level 1 of face f keeps its red, f/6.
+    let out = src.with_extension("out.exr");
+    let lvl1 = parvo::io::load_with(
+        s(&out),
+        &parvo::io::Limits::default(),
+        &parvo::io::LoadOptions {
+            environment: parvo::io::EnvironmentMaps::Accept,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .levels[1]
+        .clone();
+    for (f, face) in parvo::env::cube::faces_from_strip(&lvl1)
+        .unwrap()
+        .iter()
+        .enumerate()
+    {
+        for (i, t) in face.to_linear().chunks(4).enumerate() {
+            assert!(
+                (t[0] - f as f32 / 6.0).abs() < 1e-3,
+                "face {f} texel {i}: {t:?}"
+            );
+        }
+    }
     let j: serde_json::Value =
         serde_json::from_str(&ok(&parvo(&["info", "--json", s(&src)]))).unwrap();
     // The six faces are read as stored, not cropped or padded.
@@ -77,7 +116,7 @@ fn a_cube_face_exr_is_refused_by_mip_and_described_by_info() {
 }
 
 #[test]
-fn a_lat_long_exr_named_by_textureformat_is_refused_by_mip() {
+fn a_lat_long_exr_named_by_textureformat_is_built_as_a_lat_long_map() {
     let dir = tempfile::tempdir().unwrap();
     let src = dir.path().join("latlong.exr");
     let mut attrs = LayerAttributes::default();
@@ -86,7 +125,7 @@ fn a_lat_long_exr_named_by_textureformat_is_refused_by_mip() {
         AttributeValue::Text(Text::from("LatLong Environment")),
     );
     env_exr(&src, 32, 16, attrs);
-    refused_by_mip_and_described_by_info(&src, "lat-long");
+    not_flattened(&src, "lat-long", "latlong", "ktx2");
 }
 
 #[test]
@@ -103,7 +142,7 @@ fn a_maketx_environment_tiff_is_refused_by_mip() {
         &dirs,
         &[(33302, TagValue::Ascii("LatLong Environment".into()))],
     );
-    refused_by_mip_and_described_by_info(&src, "lat-long");
+    not_flattened(&src, "lat-long", "latlong", "ktx2");
 }
 
 #[test]
