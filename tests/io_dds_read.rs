@@ -266,7 +266,7 @@ fn what_parvo_cannot_read_is_named() {
                 vec![0; 128],
             ]
             .concat(),
-            "texture arrays",
+            "a 2-D array of 2",
         ),
         (
             [

@@ -642,9 +642,10 @@ impl<'a> Banded<'a> {
         let reducer = super::separable::Reducer::new(
             f32fmt, w as u32, h as u32, w1 as u32, h1 as u32, options,
         );
-        // The fast row kernel where the whole-image build takes it
-        // (`sep_fast`), so both builds give the same levels.
-        let reducer = if super::sep_fast::takes(&base, options) {
+        // The fast row kernel whenever fast paths are on: the whole-image
+        // build of the same f32 rows takes it (`sep_fast`), so both
+        // builds give the same levels.
+        let reducer = if options.fast_paths {
             reducer.fast()
         } else {
             reducer

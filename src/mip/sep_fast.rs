@@ -33,16 +33,6 @@ use crate::texture::Texture;
 /// eight per thread for balance.
 const MAX_BAND: usize = 64;
 
-/// True when [`try_reduce_linear`] reduces `src` (fast paths on, and a
-/// source type it reads): the banded build uses the same kernel then.
-pub(crate) fn takes(src: &Texture, options: &MipOptions) -> bool {
-    options.fast_paths
-        && matches!(
-            (src.texels(), src.format().color_space),
-            (Texels::F32(_), ColorSpace::Linear) | (Texels::U8(_) | Texels::U16(_), _)
-        )
-}
-
 /// The reduction of `src` to `w × h` in linear f32 (and, with `encode`,
 /// in that format too), or `None` when the source type has no fast path
 /// here (f16, or sRGB-encoded floats: they take the plain path).
