@@ -39,7 +39,9 @@ fn bytes(t: &Texture) -> Vec<u8> {
 
 /// Every image's levels as (size, format, bytes): equal even where the
 /// texels are NaN (the conformance files hold some).
-fn image_bytes(images: &[Vec<Texture>]) -> Vec<Vec<(u32, u32, Format, Vec<u8>)>> {
+type Stored = (u32, u32, Format, Vec<u8>);
+
+fn image_bytes(images: &[Vec<Texture>]) -> Vec<Vec<Stored>> {
     images
         .iter()
         .map(|l| {
@@ -87,7 +89,8 @@ fn chains(faces: Vec<Texture>) -> Vec<MipChain> {
 /// level by level.
 #[test]
 fn conformance_files_read_as_ktx_extract_reads_them() {
-    let cases: [(&str, Kind, &dyn Fn(usize, usize) -> String); 3] = [
+    type Golden<'a> = &'a dyn Fn(usize, usize) -> String;
+    let cases: [(&str, Kind, Golden); 3] = [
         ("valid_R8G8B8A8_UNORM_CUBE_MIP", Kind::Cube, &|k, i| {
             format!("output_level{k}_face{i}.raw")
         }),
@@ -218,7 +221,7 @@ fn written_cube_maps_and_arrays_follow_the_ktx2_layout() {
         // level first in the file, nothing after the largest.
         assert_eq!(a.dfd.0 as usize, 80 + 24 * a.levels.len(), "{name}");
         assert_eq!(a.kvd.0, a.dfd.0 + a.dfd.1, "{name}");
-        let align = if texel % 4 == 0 {
+        let align = if texel.is_multiple_of(4) {
             texel
         } else {
             texel * 4 / gcd(texel, 4)
@@ -328,8 +331,8 @@ fn openexr_environments_are_strips_and_lat_long_maps_with_envmap() {
         .map(|t| (t.width(), t.height()))
         .collect();
     assert_eq!(sizes, [(8, 48), (4, 24), (2, 12), (1, 6), (1, 3), (1, 1)]);
-    for k in 0..4 {
-        let stacked = faces_from_strip(&back.levels[k]).unwrap();
+    for (k, level) in back.levels.iter().enumerate().take(4) {
+        let stacked = faces_from_strip(level).unwrap();
         for f in 0..6 {
             assert_eq!(stacked[f], levels[f][k], "level {k} face {f}");
         }
@@ -647,7 +650,7 @@ fn mip_builds_environment_maps_from_every_input() {
     for (f, t) in faces.iter().enumerate() {
         let path = p(&format!("face{f}.exr"));
         io::save(
-            &[t.clone()],
+            std::slice::from_ref(t),
             Rounding::Down,
             &path,
             OutputKind::EXR,

@@ -242,7 +242,7 @@ fn read(inputs: &[String], env: Option<EnvArg>, settings: &Settings) -> Result<S
         let images = loaded
             .into_images()
             .into_iter()
-            .map(|levels| levels.into_iter().next().expect("level 0"))
+            .filter_map(|levels| levels.into_iter().next())
             .collect();
         return Ok(Source::Images(kind, images));
     }

@@ -547,7 +547,7 @@ pub fn fix_edges(faces: Vec<MipChain>, from_level: usize) -> Result<Vec<MipChain
             faces.len()
         )));
     }
-    let options: Vec<MipOptions> = faces.iter().map(|c| c.options().clone()).collect();
+    let options: Vec<MipOptions> = faces.iter().map(|c| *c.options()).collect();
     let mut levels: Vec<Vec<Texture>> = faces.into_iter().map(MipChain::into_levels).collect();
     let count = levels.iter().map(Vec::len).min().unwrap_or(0);
     for k in from_level..count {
@@ -555,7 +555,7 @@ pub fn fix_edges(faces: Vec<MipChain>, from_level: usize) -> Result<Vec<MipChain
         if n < 2 {
             continue;
         }
-        let lin: Vec<Vec<f32>> = (0..6).map(|f| levels[f][k].to_linear()).collect();
+        let lin: Vec<Vec<f32>> = levels.iter().map(|face| face[k].to_linear()).collect();
         let ch = levels[0][k].channels();
         let f0 = levels[0][k].format();
         let straight = (f0.alpha == crate::texel::AlphaMode::Straight)

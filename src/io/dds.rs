@@ -1521,7 +1521,9 @@ pub fn load_with(path: &Path, limits: &Limits, options: &super::LoadOptions) -> 
         );
     }
     let mut all = all.into_iter();
-    let levels = all.next().expect("one image or more");
+    let Some(levels) = all.next() else {
+        return Err(decode_err("no image"));
+    };
     let base = &levels[0];
     let format = base.format();
     let mut info = SourceInfo::new(FileFormat::Dds, &format);

@@ -1538,7 +1538,9 @@ fn cube_strip_levels(faces: &[&[Texture]], rounding: Rounding) -> Result<Vec<Tex
             strip.len()
         )));
     }
-    let last = strip.pop().expect("two levels or more");
+    let Some(last) = strip.pop() else {
+        return Err(encode_err("no levels"));
+    };
     let options = crate::mip::MipOptions {
         rounding,
         ..Default::default()

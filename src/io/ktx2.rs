@@ -1004,7 +1004,9 @@ fn load_bytes(bytes: &[u8], limits: &Limits, options: &super::LoadOptions) -> Re
         notes.extend(note);
     }
     let mut images = images.into_iter();
-    let levels = images.next().expect("at least one image");
+    let Some(levels) = images.next() else {
+        return Err(decode_err("no images"));
+    };
     let attributes = attributes_of(&r, vk, block, scheme);
     let wrap = super::recorded_wrap(
         attributes

@@ -229,10 +229,14 @@ impl Loaded {
         self.into_images()
             .into_iter()
             .map(|levels| {
-                if levels.len() > 1 {
-                    MipChain::from_levels(levels, options.clone())
-                } else {
-                    mip::build(levels.into_iter().next().expect("one level"), &options)
+                let mut levels = levels.into_iter();
+                match (levels.next(), levels.len()) {
+                    (Some(base), 0) => mip::build(base, &options),
+                    (Some(base), _) => MipChain::from_levels(
+                        std::iter::once(base).chain(levels).collect(),
+                        options,
+                    ),
+                    (None, _) => Err(Error::InvalidOption("an image without levels".into())),
                 }
             })
             .collect()
