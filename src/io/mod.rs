@@ -510,6 +510,8 @@ pub fn peek_kind(path: &Path) -> crate::env::Kind {
         dds::peek_kind(head)
     } else if exr::OpenExr.detect(head) {
         exr::peek_kind(path)
+    } else if tiff::Tiff.detect(head) {
+        tiff::peek_kind(path)
     } else {
         crate::env::Kind::Plain
     }

@@ -677,6 +677,23 @@ fn environment(texture_format: Option<&str>) -> Option<Environment> {
     }
 }
 
+/// The environment kind a TIFF's first directory declares with maketx's
+/// `textureformat` tag: [`crate::env::Kind::LatLong`] for `LatLong
+/// Environment`, else `Plain` (also for a file that does not read). A
+/// `CubeFace Environment` stays `Plain`: maketx lays its faces out 3x2,
+/// which parvo does not build from, and the load refuses it in words.
+pub(crate) fn peek_kind(path: &Path) -> crate::env::Kind {
+    let read = || {
+        let file = File::open(path).ok()?;
+        let mut d = Decoder::new(BufReader::new(file)).ok()?;
+        ascii_tag(&mut d, Tag::Unknown(tag::TEXTURE_FORMAT))
+    };
+    match std::panic::catch_unwind(read).ok().flatten().as_deref() {
+        Some("LatLong Environment") => crate::env::Kind::LatLong,
+        _ => crate::env::Kind::Plain,
+    }
+}
+
 /// Load a TIFF file (see the module docs).
 pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loaded> {
     let open = || {

@@ -7,8 +7,8 @@
 //! naming the kind; since issue 30 it builds them as what they are (each
 //! cube face filtered on its own, the output marked as an environment)
 //! and refuses only outputs that cannot hold the kind. `info` reads them
-//! and says what they are. A maketx `.tx` environment map (TIFF) is still
-//! refused by `mip`.
+//! and says what they are. A maketx `.tx` lat-long map (TIFF) is built
+//! as one too; a `.tx` cube (faces laid out 3x2) is refused in words.
 
 use crate::util::{TagValue, ok, parvo, s, write_tiff_u8};
 use exr::prelude::*;
@@ -138,28 +138,44 @@ fn a_lat_long_exr_named_by_textureformat_is_built_as_a_lat_long_map() {
     not_flattened(&src, "lat-long", "latlong", "plain.ktx2");
 }
 
-#[test]
-fn a_maketx_environment_tiff_is_refused_by_mip() {
+/// A maketx-style `.tx` (TIFF mip levels) tagged with `textureformat`.
+fn maketx_tiff(path: &std::path::Path, format: &str, w: u32, h: u32) {
     use tiff::encoder::colortype::RGB8;
+    let mut dirs = vec![];
+    let (mut lw, mut lh) = (w, h);
+    loop {
+        dirs.push((lw, lh, vec![100; (lw * lh * 3) as usize]));
+        if lw == 1 && lh == 1 {
+            break;
+        }
+        (lw, lh) = ((lw / 2).max(1), (lh / 2).max(1));
+    }
+    write_tiff_u8::<RGB8>(path, &dirs, &[(33302, TagValue::Ascii(format.into()))]);
+}
+
+#[test]
+fn a_maketx_lat_long_tiff_is_built_as_a_lat_long_map() {
+    // maketx --envlatl writes a .tx: `mip` builds it as the lat-long map it
+    // is (the output an environment map), never as a flat image.
     let dir = tempfile::tempdir().unwrap();
     let src = dir.path().join("env.tx");
-    let dirs: Vec<(u32, u32, Vec<u8>)> = [(8u32, 4u32), (4, 2), (2, 1), (1, 1)]
-        .iter()
-        .map(|&(w, h)| (w, h, vec![100; (w * h * 3) as usize]))
-        .collect();
-    write_tiff_u8::<RGB8>(
-        &src,
-        &dirs,
-        &[(33302, TagValue::Ascii("LatLong Environment".into()))],
-    );
-    // `mip` builds OpenEXR, KTX2 and DDS environments; a TIFF one is still
-    // refused rather than flattened.
-    let out = src.with_extension("out.ktx2");
+    maketx_tiff(&src, "LatLong Environment", 8, 4);
+    not_flattened(&src, "lat-long", "latlong", "plain.ktx2");
+}
+
+#[test]
+fn a_maketx_cube_face_tiff_is_refused_by_mip() {
+    // maketx lays a TIFF cube's faces out 3x2, which parvo does not build
+    // from: refused in words rather than flattened.
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("cube.tx");
+    maketx_tiff(&src, "CubeFace Environment", 24, 16);
+    let out = src.with_extension("out.exr");
     let r = parvo(&["mip", s(&src), "-o", s(&out)]);
     let err = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(1), "mip must refuse: {err}");
     assert!(
-        err.contains("lat-long environment map"),
+        err.contains("cube-face environment map"),
         "the error names the kind: {err}"
     );
     assert!(!out.exists(), "nothing is written");
