@@ -19,6 +19,15 @@
 //!   smooth gradients, fine texture and sharp edges, as photographs do
 //!   (the input of the block-compression table; fixed seed, the same for
 //!   every run).
+//! - `sky`: a lat-long (equirectangular) environment map, `SIZE` wide and
+//!   `SIZE / 2` high (y up, directions as [`crate::env::latlong`] maps
+//!   them), sRGB RGBA8: a sky darkening from the horizon to the zenith with
+//!   a sun disc, soft fractal clouds that wrap around in longitude, thin
+//!   meridians every 30° and parallels every 15° that converge on the
+//!   pole, and below the horizon a ground plane of unit squares seen from
+//!   height 1, whose checker grows finer without end towards the horizon.
+//!   Each texel averages 3×3 directions over its cell. The input of the
+//!   `sky` and `sphere` scenes ([`crate::scene`]).
 
 use crate::error::{Error, Result};
 use crate::texel::{ChannelType, ColorSpace, Format};
@@ -41,6 +50,17 @@ pub enum Builtin {
     Bumps,
     /// A photo-like colour image.
     Photo,
+    /// A lat-long environment map (`SIZE × SIZE/2`).
+    Sky,
+}
+
+/// The width and height of `kind` at `size`: `size × size`, except
+/// [`Builtin::Sky`], `size × max(1, size / 2)`.
+pub fn dimensions(kind: Builtin, size: u32) -> (u32, u32) {
+    match kind {
+        Builtin::Sky => (size, (size / 2).max(1)),
+        _ => (size, size),
+    }
 }
 
 /// True if `name` names a built-in texture (starts with `builtin:`).
@@ -65,11 +85,12 @@ pub fn parse(name: &str) -> Result<(Builtin, u32)> {
         "zoneplate" => Builtin::ZonePlate,
         "bumps" => Builtin::Bumps,
         "photo" => Builtin::Photo,
+        "sky" => Builtin::Sky,
         _ => {
             return Err(Error::parse(
                 "built-in texture",
                 name,
-                "known textures: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE], builtin:photo[:SIZE]",
+                "known textures: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE], builtin:photo[:SIZE], builtin:sky[:SIZE]",
             ));
         }
     };
@@ -97,12 +118,14 @@ pub fn parse(name: &str) -> Result<(Builtin, u32)> {
     Ok((kind, size))
 }
 
-/// Generate a built-in texture of `size × size` texels.
+/// Generate a built-in texture of `size × size` texels ([`dimensions`]
+/// for the lat-long `sky`).
 pub fn generate(kind: Builtin, size: u32) -> Result<Texture> {
     let n = size as usize;
     match kind {
         Builtin::Bumps => crate::shade::builtin_bumps(size),
         Builtin::Photo => photo(size),
+        Builtin::Sky => sky(size),
         Builtin::Checker => {
             let cell = (n / 8).max(1);
             let mut v = vec![0u8; n * n * 4];
@@ -233,6 +256,99 @@ fn photo(size: u32) -> Result<Texture> {
     )
 }
 
+/// Linear RGB of the `sky` built-in in unit direction `d` (module docs).
+fn sky_radiance(d: [f64; 3], s: f64) -> [f64; 3] {
+    let elev = d[1].clamp(-1.0, 1.0).asin();
+    if d[1] < 0.0 {
+        // The ground: unit squares on the plane y = -1.
+        let k = -1.0 / d[1];
+        let (gx, gz) = (d[0] * k, d[2] * k);
+        let on = ((gx.floor() + gz.floor()) as i64).rem_euclid(2) == 0;
+        let haze = (-k / 40.0).exp();
+        let c = if on {
+            [0.30, 0.24, 0.16]
+        } else {
+            [0.09, 0.11, 0.06]
+        };
+        let h = [0.55, 0.62, 0.72];
+        return [0, 1, 2].map(|i| c[i] * haze + h[i] * (1.0 - haze));
+    }
+    let a = (elev / std::f64::consts::FRAC_PI_2).clamp(0.0, 1.0);
+    let mut rgb = [
+        0.60 + (0.06 - 0.60) * a.sqrt(),
+        0.70 + (0.16 - 0.70) * a.sqrt(),
+        0.85 + (0.55 - 0.85) * a.sqrt(),
+    ];
+    // Clouds: value noise periodic in longitude (8 cells around at the
+    // coarsest octave), thinning towards the zenith.
+    let mut n = 0.0;
+    let mut amp = 0.5;
+    for o in 0..5u64 {
+        let cells = 8u64 << o;
+        let (fx, fy) = (s * cells as f64, a * cells as f64 / 4.0);
+        let (ix, iy) = (fx.floor(), fy.floor());
+        let (tx, ty) = (fx - ix, fy - iy);
+        let (tx, ty) = (tx * tx * (3.0 - 2.0 * tx), ty * ty * (3.0 - 2.0 * ty));
+        let g = |dx: u64, dy: u64| lattice(((ix as u64) + dx) % cells, iy as u64 + dy, o + 11, 3);
+        let top = g(0, 0) + (g(1, 0) - g(0, 0)) * tx;
+        let bot = g(0, 1) + (g(1, 1) - g(0, 1)) * tx;
+        n += amp * (top + (bot - top) * ty);
+        amp *= 0.5;
+    }
+    let cloud = ((n - 0.05) * 2.5).clamp(0.0, 1.0) * (1.0 - a * a);
+    for c in rgb.iter_mut() {
+        *c += (0.92 - *c) * cloud;
+    }
+    // Meridians every 30° and parallels every 15°, about 0.3° wide.
+    let lon = (s * 360.0).rem_euclid(30.0);
+    let lat = elev.to_degrees().rem_euclid(15.0);
+    let width = 0.3 / elev.cos().max(1e-3);
+    if lon.min(30.0 - lon) < width || lat.min(15.0 - lat) < 0.3 {
+        rgb = [0.05, 0.08, 0.25];
+    }
+    // The sun: 2° across, 30° up, at s = 0.42.
+    let sun = crate::env::latlong::st_to_direction(0.42, 1.0 / 3.0);
+    let cos = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2];
+    if cos > 1f64.to_radians().cos() {
+        rgb = [1.0, 0.97, 0.85];
+    }
+    rgb
+}
+
+/// The `sky` built-in (see the module docs).
+fn sky(size: u32) -> Result<Texture> {
+    use rayon::prelude::*;
+    let (w, h) = dimensions(Builtin::Sky, size);
+    let (wn, hn) = (w as usize, h as usize);
+    let encode = |v: f64| {
+        let v = v.clamp(0.0, 1.0);
+        let e = if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (e * 255.0).round() as u8
+    };
+    let mut v = vec![0u8; wn * hn * 4];
+    v.par_chunks_mut(wn * 4).enumerate().for_each(|(y, row)| {
+        for (x, t) in row.chunks_exact_mut(4).enumerate() {
+            let mut acc = [0f64; 3];
+            for j in 0..3 {
+                for i in 0..3 {
+                    let s = (x as f64 + (i as f64 + 0.5) / 3.0) / w as f64;
+                    let tt = (y as f64 + (j as f64 + 0.5) / 3.0) / h as f64;
+                    let c = sky_radiance(crate::env::latlong::st_to_direction(s, tt), s);
+                    for k in 0..3 {
+                        acc[k] += c[k] / 9.0;
+                    }
+                }
+            }
+            t.copy_from_slice(&[encode(acc[0]), encode(acc[1]), encode(acc[2]), 255]);
+        }
+    });
+    Texture::from_u8(w, h, Format::new(4, ChannelType::U8, ColorSpace::Srgb), v)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -255,5 +371,12 @@ mod tests {
         }
         let t = load("builtin:checker:16").unwrap();
         assert_eq!((t.width(), t.height()), (16, 16));
+        let t = load("builtin:sky:16").unwrap();
+        assert_eq!((t.width(), t.height()), (16, 8));
+        assert_eq!(
+            (t.width(), t.height()),
+            dimensions(Builtin::Sky, 16),
+            "dimensions() is what generate() makes"
+        );
     }
 }

@@ -75,8 +75,9 @@ impl CacheTexture {
     pub fn builtin(name: &str) -> Result<Self> {
         let (kind, size) = crate::builtin::parse(name)?;
         let format = crate::builtin::generate(kind, 1)?.format();
+        let (w, h) = crate::builtin::dimensions(kind, size);
         Ok(CacheTexture {
-            chain: Arc::new(stand_in(size, size, format, &MipOptions::default())?),
+            chain: Arc::new(stand_in(w, h, format, &MipOptions::default())?),
             blocks: None,
             stand_in: true,
         })

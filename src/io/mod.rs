@@ -599,7 +599,8 @@ fn load_stored(
 ) -> Result<Loaded> {
     if crate::builtin::is_builtin(spec) {
         let (kind, size) = crate::builtin::parse(spec)?;
-        limits.check(size as u64, size as u64, size as u64 * size as u64 * 4)?;
+        let (w, h) = crate::builtin::dimensions(kind, size);
+        limits.check(w as u64, h as u64, w as u64 * h as u64 * 4)?;
         let t = crate::builtin::generate(kind, size)?;
         let info = SourceInfo::new(FileFormat::Builtin, &t.format());
         return Ok(Loaded::plain(vec![t], info));
