@@ -51,10 +51,11 @@ use parvo::scene::{Frame, RasterOrder, Scene};
     Cache spec: SIZE:LINE:WAYS[:POLICY], SIZE as 16384, 16K, 16KiB or 4M, WAYS a number or `full`, \
     POLICY lru (default), fifo or random. Layouts: linear, tiled:WxH, morton, morton:WxH, \
     blocked:WxH:SWxSH. Orders: scanline, tiled:N, morton, hilbert. Scenes: plane, tunnel, zoom, \
-    rotate:DEG[:SCALE].\n\nExit codes: 0 success; 1 failure; 2 usage error."
+    rotate:DEG[:SCALE], sky, sphere (a lat-long environment map looked up by direction: s \
+    repeats, t clamps).\n\nExit codes: 0 success; 1 failure; 2 usage error."
 )]
 pub struct CachesimArgs {
-    /// Scene: plane, tunnel, zoom, rotate:DEG[:SCALE].
+    /// Scene: plane, tunnel, zoom, rotate:DEG[:SCALE], sky or sphere (these two read --texture as a lat-long environment map).
     #[arg(long, default_value = "plane", value_name = "SCENE")]
     scene: Scene,
     /// Frame size in pixels.
@@ -366,20 +367,28 @@ fn texture_for(args: &CachesimArgs, filters: &[SamplerOptions]) -> Result<CacheT
     let values = filters.iter().any(shape::reads_depend_on_values);
     if !values && parvo::builtin::is_builtin(spec) && args.read.color == ColorArg::Auto {
         return parvo::builtin::parse(spec)
-            .and_then(|(_, size)| {
-                let n = size as u64;
-                parvo::io::Limits::default().check(n, n, n * n * 4)
+            .and_then(|(kind, size)| {
+                let (w, h) = parvo::builtin::dimensions(kind, size);
+                let (w, h) = (w as u64, h as u64);
+                parvo::io::Limits::default().check(w, h, w * h * 4)
             })
             .and_then(|()| CacheTexture::builtin(spec))
             .map_err(super::with_hint)
             .with_context(|| format!("cannot read texture `{spec}`"));
     }
-    let (chain, blocks) = args.read.load_chain(spec)?;
+    let (chain, blocks) = args
+        .read
+        .load_for_scene(spec, &args.scene)?
+        .into_chain()
+        .with_context(|| format!("cannot read texture `{spec}`"))?;
     Ok(CacheTexture::loaded(Arc::new(chain), blocks))
 }
 
 fn sampler_options(args: &CachesimArgs, name: &str) -> Result<SamplerOptions> {
     let mut o = SamplerOptions::from_name(name)?;
+    if let Some(w) = args.scene.wrap() {
+        o.wrap = w;
+    }
     if let Some(n) = args.max_aniso {
         o.max_aniso = n;
     }

@@ -25,7 +25,7 @@ use super::images::{write_image, write_rgb};
     filter's level weights, shaded by the image's luminance."
 )]
 pub struct RenderArgs {
-    /// Scene: plane, tunnel, zoom, rotate:DEG[:SCALE].
+    /// Scene: plane, tunnel, zoom, rotate:DEG[:SCALE], sky or sphere (these two read --texture as a lat-long environment map).
     #[arg(long, default_value = "plane", value_name = "SCENE")]
     scene: Scene,
     /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
@@ -139,7 +139,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
     if let Some(b) = args.shade {
         return shade(&args, b);
     }
-    let store = TextureStore::from_loaded(args.read.load(&args.texture)?);
+    let store = TextureStore::from_loaded(args.read.load_for_scene(&args.texture, &args.scene)?);
     let wrap = store.options().wrap;
     let base = store.base();
     let tex = (base.width(), base.height());

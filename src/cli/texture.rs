@@ -9,6 +9,7 @@ use parvo::MipChain;
 use parvo::compress::BlockFormat;
 use parvo::io::{self, Limits, LoadOptions, Loaded};
 use parvo::mip::NanPolicy;
+use parvo::scene::Scene;
 use parvo::texel::ColorSpace;
 
 use super::mip::ColorArg;
@@ -70,6 +71,34 @@ impl TextureArgs {
             ..self.options()
         };
         self.load_as(spec, options)
+    }
+
+    /// [`Self::load`] for `scene`: an environment scene (`sky`, `sphere`)
+    /// reads the texture as a lat-long map (a lat-long OpenEXR or maketx
+    /// file as one, any 2-D image taken as one) with the scene's
+    /// addressing, s repeating and t clamped, which the chain is built
+    /// and sampled with; a cube map or an array is refused, saying how to
+    /// convert it.
+    pub fn load_for_scene(&self, spec: &str, scene: &Scene) -> Result<Loaded> {
+        let Some(wrap) = scene.wrap() else {
+            return self.load(spec);
+        };
+        let mut loaded = self.load_environment(spec)?;
+        let kind = loaded.info.kind;
+        let cube = loaded.info.environment == Some(io::Environment::Cube);
+        if kind.images() > 1 || cube {
+            let what = if cube {
+                "a cube map".to_string()
+            } else {
+                format!("a {}", kind.describe())
+            };
+            anyhow::bail!(
+                "the {scene} scene looks up a lat-long environment map, and `{spec}` is {what}: \
+                 convert it first with `parvo mip --env latlong {spec} -o latlong.exr`"
+            );
+        }
+        loaded.info.wrap = Some(wrap);
+        Ok(loaded)
     }
 
     fn load_as(&self, spec: &str, options: LoadOptions) -> Result<Loaded> {

@@ -50,7 +50,7 @@ const ORDER: &str = tradeoff::DEFAULT_ORDER;
     gaussian, 320x240, into ./parvo-tradeoff."
 )]
 pub struct TradeoffArgs {
-    /// Scene: plane, tunnel, zoom, rotate:DEG[:SCALE].
+    /// Scene: plane, tunnel, zoom, rotate:DEG[:SCALE], sky or sphere (these two read --texture as a lat-long environment map).
     #[arg(long, default_value = "plane", value_name = "SCENE")]
     scene: Scene,
     /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
@@ -212,7 +212,7 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
             return Ok(ExitCode::from(2));
         }
     };
-    let store = TextureStore::from_loaded(args.read.load(&args.texture)?);
+    let store = TextureStore::from_loaded(args.read.load_for_scene(&args.texture, &args.scene)?);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let bar = if std::io::stderr().is_terminal() {

@@ -20,7 +20,21 @@
 //! - [`Zoom`]: one frame sweeping from 8× magnification at the left edge to
 //!   1/256 minification at the right (λ from −3 to 8);
 //! - [`Rotate`]: a screen-filling texture turned by an angle, a fixed
-//!   number of texels per pixel (λ = log2(scale) everywhere).
+//!   number of texels per pixel (λ = log2(scale) everywhere);
+//! - [`Sky`]: a pinhole camera looking up at the sky of a lat-long
+//!   environment map (the texture read as one: s around, t from the north
+//!   pole down, [`crate::env::latlong`]'s mapping), horizon and ground in
+//!   the lower part of the frame, the stretched rows near the pole at the
+//!   top;
+//! - [`Sphere`]: a mirror sphere reflecting a lat-long environment map,
+//!   every direction at once, squeezed towards the silhouette (pixels off
+//!   the sphere show no texture).
+//!
+//! The environment scenes look the map up as a 2-D texture with the exact
+//! derivatives of (s, t), as OpenImageIO's `texture()` and parvo's EWA
+//! and summed-area lookups by direction do: s repeats, t clamps
+//! ([`Scene::wrap`]); differences across the s = 0 seam take the short
+//! way.
 
 pub mod metrics;
 pub mod order;
@@ -143,6 +157,51 @@ pub struct Rotate {
     pub scale: f64,
 }
 
+/// Looking up at a lat-long sky from the ground.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sky {
+    /// Vertical field of view, radians.
+    pub fov_y: f64,
+    /// Elevation of the view direction above the horizon, radians.
+    pub pitch: f64,
+    /// Longitude of the view direction, radians (0: looking along +z, the
+    /// middle of the map).
+    pub yaw: f64,
+}
+
+impl Default for Sky {
+    /// 100° field of view, 35° up (the horizon near the bottom edge, 85°
+    /// at the top edge's middle and the pole past the top corners), 20°
+    /// round from the middle of the map.
+    fn default() -> Self {
+        Sky {
+            fov_y: 100f64.to_radians(),
+            pitch: 35f64.to_radians(),
+            yaw: 20f64.to_radians(),
+        }
+    }
+}
+
+/// A mirror sphere of radius 1 seen from `distance` along +z.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Camera distance from the sphere's centre (more than 1).
+    pub distance: f64,
+    /// Vertical field of view, radians.
+    pub fov_y: f64,
+}
+
+impl Default for Sphere {
+    /// 3 radii away, the sphere 85 % of the frame's height.
+    fn default() -> Self {
+        let distance = 3.0;
+        Sphere {
+            distance,
+            fov_y: 2.0 * (1.0 / distance).asin() / 0.85,
+        }
+    }
+}
+
 /// The scenes (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Scene {
@@ -154,6 +213,10 @@ pub enum Scene {
     Zoom(Zoom),
     /// A rotated, uniformly scaled texture.
     Rotate(Rotate),
+    /// A lat-long sky seen through a camera.
+    Sky(Sky),
+    /// A lat-long environment in a mirror sphere.
+    Sphere(Sphere),
 }
 
 impl Default for Scene {
@@ -168,6 +231,8 @@ impl fmt::Display for Scene {
             Scene::Plane(_) => f.write_str("plane"),
             Scene::Tunnel(_) => f.write_str("tunnel"),
             Scene::Zoom(_) => f.write_str("zoom"),
+            Scene::Sky(_) => f.write_str("sky"),
+            Scene::Sphere(_) => f.write_str("sphere"),
             Scene::Rotate(r) if r.scale == 1.0 => write!(f, "rotate:{}", r.degrees),
             Scene::Rotate(r) => write!(f, "rotate:{}:{}", r.degrees, r.scale),
         }
@@ -177,13 +242,15 @@ impl fmt::Display for Scene {
 impl FromStr for Scene {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        let expected = "expected plane, tunnel, zoom or rotate:DEG[:SCALE]";
+        let expected = "expected plane, tunnel, zoom, rotate:DEG[:SCALE], sky or sphere";
         let t = s.trim().to_ascii_lowercase();
         let mut parts = t.split(':');
         let scene = match parts.next().unwrap_or("") {
             "plane" => Scene::Plane(Plane::default()),
             "tunnel" => Scene::Tunnel(Tunnel::default()),
             "zoom" => Scene::Zoom(Zoom::default()),
+            "sky" => Scene::Sky(Sky::default()),
+            "sphere" => Scene::Sphere(Sphere::default()),
             "rotate" => {
                 let num = |p: Option<&str>, what: &str| -> Result<Option<f64>> {
                     match p {
@@ -221,6 +288,23 @@ impl FromStr for Scene {
 }
 
 impl Scene {
+    /// True for the scenes that read their texture as a lat-long
+    /// environment map ([`Sky`], [`Sphere`]).
+    pub fn is_environment(&self) -> bool {
+        matches!(self, Scene::Sky(_) | Scene::Sphere(_))
+    }
+
+    /// The addressing the scene's mapping needs, if it needs one: a
+    /// lat-long map repeats in s (around the horizon) and clamps in t (at
+    /// the poles). `None`: the texture's own.
+    pub fn wrap(&self) -> Option<crate::wrap::Wrap> {
+        use crate::wrap::{Wrap, WrapMode};
+        self.is_environment().then_some(Wrap {
+            u: WrapMode::Repeat,
+            v: WrapMode::ClampToEdge,
+        })
+    }
+
     /// This scene set up for `frame` and a level-0 texture of `tex` texels:
     /// the per-frame constants computed once, for a frame's worth of
     /// [`View::query`] calls (same values as [`Scene::query`]).
@@ -270,7 +354,15 @@ mod tests {
 
     #[test]
     fn names_round_trip_and_bad_names_are_errors() {
-        for n in ["plane", "tunnel", "zoom", "rotate:30", "rotate:12.5:4"] {
+        for n in [
+            "plane",
+            "tunnel",
+            "zoom",
+            "rotate:30",
+            "rotate:12.5:4",
+            "sky",
+            "sphere",
+        ] {
             assert_eq!(n.parse::<Scene>().unwrap().to_string(), n);
         }
         for bad in ["", "rotate", "rotate:x", "rotate:30:0", "plane:3", "cube"] {

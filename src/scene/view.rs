@@ -12,7 +12,8 @@
 //! values.
 
 use super::plane::{PlaneCamera, PlaneGrid};
-use super::{Frame, Scene, Tunnel, Zoom};
+use super::{Frame, Scene, Sky, Sphere, Tunnel, Zoom};
+use crate::env::latlong::direction_to_st;
 use crate::sample::Query;
 
 /// A [`Scene`] set up for one frame and level-0 texture size.
@@ -27,6 +28,24 @@ enum Kind {
     Tunnel(TunnelView),
     Zoom(ZoomView),
     Rotate(RotateView),
+    Env(EnvView),
+}
+
+/// A pinhole camera's ray directions, and for a mirror sphere the
+/// reflection: both end in a direction looked up as (s, t).
+#[derive(Clone, Copy, Debug)]
+struct EnvView {
+    w: f64,
+    h: f64,
+    /// tan(fov_y / 2) × aspect, tan(fov_y / 2).
+    sx: f64,
+    sy: f64,
+    forward: [f64; 3],
+    right: [f64; 3],
+    up: [f64; 3],
+    /// The camera's distance from a mirror sphere's centre, on +z; `None`
+    /// for the sky.
+    sphere: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -103,6 +122,8 @@ impl View {
                     cs,
                 })
             }
+            Scene::Sky(k) => Kind::Env(EnvView::sky(&k, w, h)),
+            Scene::Sphere(k) => Kind::Env(EnvView::sphere(&k, w, h)),
         };
         View { kind }
     }
@@ -116,6 +137,7 @@ impl View {
             Kind::Tunnel(v) => v.uv(x, y),
             Kind::Zoom(v) => Some(v.uv(x, y)),
             Kind::Rotate(v) => Some(v.uv(x, y)),
+            Kind::Env(v) => v.uv(x, y),
         }
     }
 
@@ -155,16 +177,17 @@ impl View {
         t: (f64, f64),
         b: (f64, f64),
     ) -> Query {
-        // The tunnel's u wraps around the circle: difference across the
-        // seam by the short way.
-        let d = |a: f64, b: f64| match &self.kind {
-            Kind::Tunnel(v) => {
-                let p = v.t.repeats_around;
-                let mut d = b - a;
-                d -= (d / p).round() * p;
-                d
-            }
-            _ => b - a,
+        // The tunnel's u wraps around the circle, a lat-long map's s
+        // around the horizon: difference across the seam by the short way.
+        let d = |a: f64, b: f64| {
+            let p = match &self.kind {
+                Kind::Tunnel(v) => v.t.repeats_around,
+                Kind::Env(_) => 1.0,
+                _ => return b - a,
+            };
+            let mut d = b - a;
+            d -= (d / p).round() * p;
+            d
         };
         Query::new(
             c.0 as f32,
@@ -216,5 +239,69 @@ impl RotateView {
             0.5 + (self.cs * dx - self.sn * dy) * self.scale / self.tw,
             0.5 + (self.sn * dx + self.cs * dy) * self.scale / self.th,
         )
+    }
+}
+
+impl EnvView {
+    fn camera(w: f64, h: f64, fov_y: f64, forward: [f64; 3], up: [f64; 3]) -> Self {
+        let tan = (fov_y * 0.5).tan();
+        // right = forward × up: +x on the screen turns towards larger s.
+        let right = [
+            forward[1] * up[2] - forward[2] * up[1],
+            forward[2] * up[0] - forward[0] * up[2],
+            forward[0] * up[1] - forward[1] * up[0],
+        ];
+        EnvView {
+            w,
+            h,
+            sx: tan * w / h,
+            sy: tan,
+            forward,
+            right,
+            up,
+            sphere: None,
+        }
+    }
+
+    fn sky(k: &Sky, w: f64, h: f64) -> Self {
+        let (sp, cp) = k.pitch.sin_cos();
+        let (sy, cy) = k.yaw.sin_cos();
+        // Longitude `yaw` from +z towards -x (s grows that way, see
+        // `direction_to_st`), elevation `pitch`.
+        let forward = [-sy * cp, sp, cy * cp];
+        let up = [sy * sp, cp, -cy * sp];
+        Self::camera(w, h, k.fov_y, forward, up)
+    }
+
+    fn sphere(k: &Sphere, w: f64, h: f64) -> Self {
+        let mut v = Self::camera(w, h, k.fov_y, [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]);
+        v.sphere = Some(k.distance);
+        v
+    }
+
+    #[inline]
+    fn uv(&self, x: f64, y: f64) -> Option<(f64, f64)> {
+        let nx = (x / self.w * 2.0 - 1.0) * self.sx;
+        let ny = (1.0 - y / self.h * 2.0) * self.sy;
+        let d: [f64; 3] =
+            std::array::from_fn(|i| self.forward[i] + nx * self.right[i] + ny * self.up[i]);
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let d = d.map(|c| c / len);
+        let Some(dist) = self.sphere else {
+            return Some(direction_to_st(d));
+        };
+        // The ray from (0, 0, dist) along d meets the unit sphere where
+        // t² + 2bt + c = 0, b = o·d, c = |o|² − 1.
+        let b = dist * d[2];
+        let disc = b * b - (dist * dist - 1.0);
+        if disc < 0.0 {
+            return None;
+        }
+        let t = -b - disc.sqrt();
+        let n = [t * d[0], t * d[1], dist + t * d[2]];
+        let dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+        Some(direction_to_st(std::array::from_fn(|i| {
+            d[i] - 2.0 * dn * n[i]
+        })))
     }
 }
