@@ -61,7 +61,7 @@ pub struct CachesimArgs {
     /// Frame size in pixels.
     #[arg(long, default_value = "512x384", value_name = "WxH")]
     size: Frame,
-    /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
+    /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map), builtin:photo[:SIZE], builtin:sky[:SIZE] (a lat-long sky, SIZE × SIZE/2, for the sky and sphere scenes).
     #[arg(long, default_value = "builtin:checker:1024", value_name = "TEXTURE")]
     texture: String,
 

@@ -37,7 +37,7 @@ const CHUNK: usize = 1 << 16;
                   value per line)."
 )]
 pub struct SampleArgs {
-    /// Texture: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE], or a file `parvo mip` reads.
+    /// Texture: builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE], builtin:photo[:SIZE], builtin:sky[:SIZE], or a file `parvo mip` reads.
     #[arg(value_name = "TEXTURE")]
     texture: String,
 

@@ -53,7 +53,7 @@ pub struct TradeoffArgs {
     /// Scene: plane, tunnel, zoom, rotate:DEG[:SCALE], sky or sphere (these two read --texture as a lat-long environment map).
     #[arg(long, default_value = "plane", value_name = "SCENE")]
     scene: Scene,
-    /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map).
+    /// Texture: a file or builtin:checker[:SIZE], builtin:zoneplate[:SIZE], builtin:bumps[:SIZE] (a normal map), builtin:photo[:SIZE], builtin:sky[:SIZE] (a lat-long sky, SIZE × SIZE/2, for the sky and sphere scenes).
     #[arg(long, default_value = "builtin:zoneplate:512", value_name = "TEXTURE")]
     texture: String,
 
