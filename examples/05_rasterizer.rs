@@ -19,6 +19,9 @@
 //! ground's queries alone in one slice with their UVs as the rasterizer
 //! made them, −30…30 (`wrapped`), and wrapped into [0, 1) by hand
 //! (`unit`). Each figure is the median of 5 timed runs.
+//! `portable_slice` is the slice with the AVX-512 paths off
+//! (`Sampler::set_simd(false)`): the per-lookup code a single call runs.
+//! `--only NAME` times that filter alone.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -593,7 +596,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect();
     let mut rows = Vec::new();
+    // `--only NAME` times one filter (for a profiler's run).
+    let only = value("--only");
     for name in ["nearest", "bilinear", "trilinear", "aniso16", "ewa"] {
+        if only.as_deref().is_some_and(|o| o != name) {
+            continue;
+        }
         let sam = samplers(&textures, SamplerOptions::from_name(name)?);
         let single = rate(frags.len(), || {
             for f in &frags {
@@ -638,9 +646,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .unwrap();
             black_box(&colours);
         });
+        // The same slices with the AVX-512 paths off: the per-lookup code
+        // a single call runs, batched (single / this is what a call costs
+        // beyond the lookup itself).
+        let mut plain = samplers(&textures, SamplerOptions::from_name(name)?);
+        plain.iter_mut().for_each(|s| s.set_simd(false));
+        let portable = rate(queries.len(), || {
+            for (t, qs) in per_texture.iter().enumerate() {
+                plain[t].sample_slice(qs, &mut colours[..qs.len()]).unwrap();
+            }
+            black_box(&colours);
+        });
         rows.push(format!(
             "{{\"name\": \"{name}\", \"single_mps\": {single:.2}, \"quad_mps\": {quad:.2}, \
-             \"slice_mps\": {slice:.2}, \"wrapped_mps\": {wrapped:.2}, \"unit_mps\": {unit_rate:.2}}}"
+             \"slice_mps\": {slice:.2}, \"portable_slice_mps\": {portable:.2}, \
+             \"wrapped_mps\": {wrapped:.2}, \"unit_mps\": {unit_rate:.2}}}"
         ));
     }
     println!(
