@@ -254,23 +254,22 @@ fn read(inputs: &[String], env: Option<EnvArg>, settings: &Settings) -> Result<S
     // A strip or a cross, told by the aspect (an OpenEXR cube map is
     // always the vertical strip).
     let layout = CubeLayout::detect(w, h).map(|(l, _)| l);
-    match (env, recorded) {
-        (_, Some(Environment::Cube)) => {
+    match (env, recorded, layout) {
+        (_, Some(Environment::Cube), _) => {
             let faces = faces_from_strip(&base)
                 .with_context(|| format!("cannot read `{spec}` as a cube map"))?;
             Ok(Source::Images(Kind::Cube, faces))
         }
-        (Some(EnvArg::Cube), None) if layout.is_some() => {
-            let layout = layout.expect("checked");
+        (Some(EnvArg::Cube), None, Some(layout)) => {
             let faces = parvo::env::cube::faces_in_layout(&base, layout)
                 .with_context(|| format!("cannot read `{spec}` as a cube map ({layout})"))?;
             Ok(Source::Images(Kind::Cube, faces))
         }
-        (_, Some(Environment::LatLong)) | (Some(EnvArg::Latlong), None) => {
+        (_, Some(Environment::LatLong), _) | (Some(EnvArg::Latlong), None, _) => {
             Ok(Source::LatLong(base))
         }
-        (Some(EnvArg::Cube), None) if w == 2 * h => Ok(Source::LatLong(base)),
-        (Some(EnvArg::Cube), _) => bail!(
+        (Some(EnvArg::Cube), None, _) if w == 2 * h => Ok(Source::LatLong(base)),
+        (Some(EnvArg::Cube), ..) => bail!(
             "`{spec}` is {w}x{h}: a cube map comes from six faces in one image ({}), a lat-long \
              map (2:1), a KTX2 or DDS cube map, or six face files",
             layouts_sentence()

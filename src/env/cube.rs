@@ -546,11 +546,16 @@ impl CubeLayout {
     /// The layout of a `w × h` image and its face size, if its aspect is
     /// one of the four.
     pub fn detect(w: u32, h: u32) -> Option<(CubeLayout, u32)> {
-        CubeLayout::ALL.into_iter().find_map(|l| {
-            let (a, b) = l.cells();
-            let n = w / a;
-            (n > 0 && w % a == 0 && u64::from(h) == u64::from(n) * u64::from(b)).then_some((l, n))
-        })
+        CubeLayout::ALL
+            .into_iter()
+            .find_map(|l| l.face_size(w, h).map(|n| (l, n)))
+    }
+
+    /// The face size of a `w × h` image in this layout, if it is one.
+    pub fn face_size(self, w: u32, h: u32) -> Option<u32> {
+        let (a, b) = self.cells();
+        let n = w / a;
+        (n > 0 && w.is_multiple_of(a) && u64::from(h) == u64::from(n) * u64::from(b)).then_some(n)
     }
 
     /// Where face `f` (GL's order) lies: its cell's column and row, and
@@ -636,14 +641,12 @@ pub fn layouts_sentence() -> String {
 /// `layout`; the image's size must be the layout's multiple of one face.
 pub fn faces_in_layout(image: &Texture, layout: CubeLayout) -> Result<Vec<Texture>> {
     let (w, h) = (image.width(), image.height());
-    let (a, b) = layout.cells();
-    let n = w / a;
-    if n == 0 || w % a != 0 || u64::from(h) != u64::from(n) * u64::from(b) {
+    let Some(n) = layout.face_size(w, h) else {
         return Err(Error::InvalidOption(format!(
             "a {w}x{h} image is not {}",
             layout.describe()
         )));
-    }
+    };
     let ch = image.channels();
     fn cut<T: Copy>(v: &[T], w: usize, ch: usize, n: usize, cell: (u32, u32, bool)) -> Vec<T> {
         let (x0, y0) = (cell.0 as usize * n, cell.1 as usize * n);
