@@ -125,13 +125,17 @@ fn rgba_f32() -> Format {
 /// The image of `layout` with face size `n` holding [`env`] (empty
 /// cells hold a value no face has).
 fn build(layout: CubeLayout, n: u32) -> Texture {
+    build_with(layout, &cells(layout), n)
+}
+
+/// [`build`] with the cells given.
+fn build_with(layout: CubeLayout, cells: &[Cell], n: u32) -> Texture {
     let (a, b) = layout.cells();
     let (w, h) = (a * n, b * n);
-    let cells = cells(layout);
     let mut v = Vec::with_capacity((w * h * 4) as usize);
     for y in 0..h {
         for x in 0..w {
-            v.extend(pixel_direction(&cells, n, x, y).map_or(EMPTY, env));
+            v.extend(pixel_direction(cells, n, x, y).map_or(EMPTY, env));
         }
     }
     Texture::from_f32(w, h, rgba_f32(), v).unwrap()
@@ -301,4 +305,53 @@ fn other_aspects_are_refused_listing_the_layouts() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("8x6") && e.contains("vertical cross"), "{e}");
+}
+
+/// The largest difference between `faces` and the environment at GL's
+/// direction of each texel centre.
+fn worst_error(faces: &[Texture]) -> f32 {
+    let mut worst = 0.0f32;
+    for (f, face) in faces.iter().enumerate() {
+        let n = face.width();
+        for j in 0..n {
+            for i in 0..n {
+                let s = (i as f64 + 0.5) / n as f64;
+                let t = (j as f64 + 0.5) / n as f64;
+                let want = env(face_direction(f, s, t));
+                let got = face.texel_linear(i, j);
+                for c in 0..4 {
+                    worst = worst.max((got[c] - want[c]).abs());
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// The check above sees a face misplaced, mirrored or turned: a cross
+/// whose −Z is stored unturned (or turned in the horizontal cross), or
+/// whose +X and −X are swapped, is read far from the environment.
+#[test]
+fn a_face_turned_or_misplaced_would_be_caught() {
+    for layout in [CubeLayout::HorizontalCross, CubeLayout::VerticalCross] {
+        let good = build(layout, 5);
+        assert!(worst_error(&faces_from_image(&good).unwrap()) <= 1e-6);
+        // −Z (the last cell) turned by 180°.
+        let mut turned = cells(layout);
+        let z = turned.len() - 1;
+        turned[z].right = turned[z].right.map(|c| -c);
+        turned[z].down = turned[z].down.map(|c| -c);
+        // +X and −X swapped (their cells are (2, 1) and (0, 1)).
+        let mut swapped = cells(layout);
+        for c in swapped.iter_mut() {
+            if c.row == 1 && c.col != 1 && c.col != 3 {
+                c.col = 2 - c.col;
+            }
+        }
+        for (what, wrong) in [("turned -z", turned), ("swapped x", swapped)] {
+            let image = build_with(layout, &wrong, 5);
+            let e = worst_error(&faces_from_image(&image).unwrap());
+            assert!(e > 0.1, "{layout} {what}: only {e} off");
+        }
+    }
 }
