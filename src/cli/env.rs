@@ -1,13 +1,15 @@
 //! `parvo sample --direction`: environment lookups by direction, read
 //! from stdin as `x y z dxdx dydx dzdx dxdy dydy dzdy` (the direction and
 //! its screen derivatives), one per line, same syntax and output as the
-//! 2-D queries.
+//! 2-D queries. A cube map comes as a KTX2/DDS cube (`--layer` picks the
+//! cube of a cube-map array), an OpenEXR strip, or any strip or cross
+//! [`parvo::env::cube::CubeLayout`] reads.
 
 use std::io::{self, BufRead, Write};
 
 use anyhow::{Context, Result, anyhow};
 use parvo::MipOptions;
-use parvo::env::cube::{build_faces, faces_from_strip};
+use parvo::env::cube::{build_faces, faces_from_image, faces_from_strip};
 use parvo::env::{CubeSampler, DirQuery, Kind, LatLongSampler, latlong};
 use parvo::io::Environment;
 use parvo::sample::SamplerOptions;
@@ -19,7 +21,7 @@ use super::texture::TextureArgs;
 pub enum EnvArg {
     /// A lat-long (equirectangular) map, y up, as OpenImageIO reads one.
     Latlong,
-    /// A vertical strip of six square faces (w x 6w, +x -x +y -y +z -z from the top).
+    /// Six square faces in one image: a strip (w x 6w, 6w x w) or a cross (4w x 3w, 3w x 4w).
     Cube,
 }
 
@@ -44,22 +46,29 @@ fn sampler(
     read: &TextureArgs,
     texture: &str,
     env: Option<EnvArg>,
+    layer: Option<f32>,
     options: SamplerOptions,
 ) -> Result<(EnvSampler, usize)> {
     let loaded = read.load_environment(texture)?;
     let channels = loaded.base().format().channels as usize;
-    match loaded.info.kind {
-        Kind::Cube if env != Some(EnvArg::Latlong) => {
-            // A KTX2 or DDS cube map: its faces, with their own levels.
+    let kind = loaded.info.kind;
+    match kind {
+        Kind::Cube | Kind::CubeArray { .. } if env != Some(EnvArg::Latlong) => {
+            // A KTX2 or DDS cube map, or the cube --layer picks of a
+            // cube-map array: its faces, with their own levels.
+            let cube = super::sample::pick_image(texture, kind, layer)?;
             let chains = loaded
                 .into_image_chains()
                 .with_context(|| format!("cannot read texture `{texture}`"))?;
             return Ok((
-                EnvSampler::Cube(CubeSampler::new(&chains, options)?),
+                EnvSampler::Cube(CubeSampler::new(&chains[6 * cube..6 * cube + 6], options)?),
                 channels,
             ));
         }
-        Kind::Plain | Kind::LatLong => {}
+        Kind::Plain | Kind::LatLong => {
+            // --layer on a texture that is not an array is refused.
+            super::sample::pick_image(texture, kind, layer)?;
+        }
         other => {
             return Err(anyhow!(
                 "`{texture}` is a {}: direction lookups read one cube map or a lat-long map",
@@ -97,9 +106,17 @@ fn sampler(
         }
         EnvArg::Cube => {
             // The faces of level 0, each mip-mapped on its own (a strip's
-            // own levels would mix faces once they are 1 texel high).
-            let faces = faces_from_strip(&loaded.into_base())
-                .with_context(|| format!("cannot read `{texture}` as a cube map"))?;
+            // own levels would mix faces once they are 1 texel high). A
+            // file that records a cube map is OpenEXR's strip; otherwise
+            // the image's aspect tells the strip or cross.
+            let recorded = loaded.info.environment == Some(Environment::Cube);
+            let base = loaded.into_base();
+            let faces = if recorded {
+                faces_from_strip(&base)
+            } else {
+                faces_from_image(&base)
+            }
+            .with_context(|| format!("cannot read `{texture}` as a cube map"))?;
             let chains = build_faces(faces, &MipOptions::default())?;
             Ok((
                 EnvSampler::Cube(CubeSampler::new(&chains, options)?),
@@ -110,16 +127,18 @@ fn sampler(
 }
 
 /// Run direction queries from stdin against `texture` read as `env` (or
-/// as the environment the file records).
+/// as the environment the file records); `layer` picks the cube of a
+/// cube-map array.
 pub fn run(
     read: &TextureArgs,
     texture: &str,
     env: Option<EnvArg>,
+    layer: Option<f32>,
     options: SamplerOptions,
     input: impl BufRead,
     mut out: impl Write,
 ) -> Result<()> {
-    let (s, channels) = sampler(read, texture, env, options)?;
+    let (s, channels) = sampler(read, texture, env, layer, options)?;
     let mut text = String::new();
     for (n, line) in input.split(b'\n').enumerate() {
         let line = line.context("reading stdin")?;

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow, bail};
-use parvo::env::cube::{build_faces, faces_from_strip, fix_edges};
+use parvo::env::cube::{CubeLayout, build_faces, faces_from_strip, fix_edges, layouts_sentence};
 use parvo::env::prefilter::{self, Lobe};
 use parvo::env::{Kind, convert, latlong};
 use parvo::io::{self, Environment, LoadOptions, OutputKind, SaveOptions};
@@ -56,10 +56,12 @@ pub struct EnvMipArgs {
         1 and up averaged with the texels across the edge (seamless for samplers without seamless \
         cube filtering; --no-edge-fixup keeps the per-face levels); write it to .ktx2 (a cube map) \
         or .exr (OpenEXR's strip of six faces, power-of-two faces). The input is a lat-long image, \
-        a vertical strip of six faces (w x 6w, as OpenEXR stores cube maps), a KTX2 cube map, or \
-        six face files in the order +x -x +y -y +z -z; a lat-long input becomes a cube map and a \
-        cube map a lat-long map when the other kind is asked for (each new texel an EWA lookup \
-        over its own footprint)."
+        six faces in one image told by its aspect (a vertical strip w x 6w as OpenEXR stores cube \
+        maps, a horizontal strip 6w x w, a horizontal cross 4w x 3w: -x +z +x -z across, +y above \
+        and -y below +z, or a vertical cross 3w x 4w: -z below -y turned 180 degrees), a KTX2 or \
+        DDS cube map, or six face files in the order +x -x +y -y +z -z; a lat-long input becomes a \
+        cube map and a cube map a lat-long map when the other kind is asked for (each new texel an \
+        EWA lookup over its own footprint)."
     )]
     pub env: Option<EnvArg>,
 
@@ -249,20 +251,28 @@ fn read(inputs: &[String], env: Option<EnvArg>, settings: &Settings) -> Result<S
     let recorded = loaded.info.environment;
     let base = loaded.into_base();
     let (w, h) = (base.width(), base.height());
-    let strip = h == 6 * w;
-    match (env, recorded) {
-        (_, Some(Environment::Cube)) | (Some(EnvArg::Cube), None) if strip => {
+    // A strip or a cross, told by the aspect (an OpenEXR cube map is
+    // always the vertical strip).
+    let layout = CubeLayout::detect(w, h).map(|(l, _)| l);
+    match (env, recorded, layout) {
+        (_, Some(Environment::Cube), _) => {
             let faces = faces_from_strip(&base)
                 .with_context(|| format!("cannot read `{spec}` as a cube map"))?;
             Ok(Source::Images(Kind::Cube, faces))
         }
-        (_, Some(Environment::LatLong)) | (Some(EnvArg::Latlong), None) => {
+        (Some(EnvArg::Cube), None, Some(layout)) => {
+            let faces = parvo::env::cube::faces_in_layout(&base, layout)
+                .with_context(|| format!("cannot read `{spec}` as a cube map ({layout})"))?;
+            Ok(Source::Images(Kind::Cube, faces))
+        }
+        (_, Some(Environment::LatLong), _) | (Some(EnvArg::Latlong), None, _) => {
             Ok(Source::LatLong(base))
         }
-        (Some(EnvArg::Cube), None) if w == 2 * h => Ok(Source::LatLong(base)),
-        (Some(EnvArg::Cube), _) => bail!(
-            "`{spec}` is {w}x{h}: a cube map comes from a strip of six faces (w x 6w), a lat-long \
-             map (2:1), a KTX2 cube map or six face files"
+        (Some(EnvArg::Cube), None, _) if w == 2 * h => Ok(Source::LatLong(base)),
+        (Some(EnvArg::Cube), ..) => bail!(
+            "`{spec}` is {w}x{h}: a cube map comes from six faces in one image ({}), a lat-long \
+             map (2:1), a KTX2 or DDS cube map, or six face files",
+            layouts_sentence()
         ),
         _ => bail!("`{spec}` is one 2-D image: say what it holds with --env latlong or --env cube"),
     }

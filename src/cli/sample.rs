@@ -14,10 +14,12 @@
 //! with 2, like clap's own usage errors.
 
 use std::io::{self, BufRead, BufWriter, Write};
+use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
 use parvo::Wrap;
+use parvo::env::{Kind, layer_index};
 use parvo::sample::{CompareOp, Filter, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
 
 /// Queries parsed and sampled per batch.
@@ -142,17 +144,32 @@ pub struct SampleArgs {
         environment() filters them."
     )]
     direction: bool,
-    /// The environment the texture holds: latlong, or cube (a w x 6w strip of faces).
+    /// The environment the texture holds: latlong, or cube (six faces in a strip or a cross).
     #[arg(
         long,
         value_name = "KIND",
         requires = "direction",
         long_help = "The environment the texture holds. latlong: an equirectangular map, y up, \
-        s = atan2(-x, z)/2pi + 1/2 (OpenImageIO's convention). cube: a vertical strip of six \
-        square faces, w x 6w, +x -x +y -y +z -z from the top (OpenEXR's cube-map layout, as \
-        maketx --envcube writes it), each face mip-mapped on its own."
+        s = atan2(-x, z)/2pi + 1/2 (OpenImageIO's convention). cube: six square faces in one \
+        image, the layout told by its aspect: a vertical strip w x 6w (+x -x +y -y +z -z from the \
+        top, OpenEXR's cube-map layout as maketx --envcube writes it), a horizontal strip 6w x w \
+        (the same order from the left), a horizontal cross 4w x 3w (-x +z +x -z across, +y above \
+        and -y below +z) or a vertical cross 3w x 4w (-x +z +x across, +y above +z, -y below it, \
+        -z below -y turned 180 degrees); each face mip-mapped on its own."
     )]
     env: Option<super::env::EnvArg>,
+    /// Array layer to sample (2-D arrays), or cube (cube-map arrays, with --direction); GL rounds it.
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        long_help = "The layer of a 2-D array (a KTX2 or DDS file with more than one layer) to \
+        sample, or with --direction the cube of a cube-map array. N is an array coordinate and is \
+        rounded as GL rounds one: floor(N + 0.5) clamped to [0, layers - 1], so --layer 1.6 reads \
+        layer 2 and --layer 9 the last layer. An array of more than one layer is refused without \
+        --layer (nothing is picked for you); a texture that is not an array is refused with it."
+    )]
+    layer: Option<f32>,
 }
 
 /// What `parvo sample` computes per query.
@@ -245,6 +262,7 @@ pub fn run(args: SampleArgs) -> Result<ExitCode> {
             &args.read,
             &args.texture,
             env,
+            args.layer,
             options,
             io::stdin().lock(),
             out,
@@ -252,8 +270,28 @@ pub fn run(args: SampleArgs) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     // A mip-mapped EXR/KTX2/DDS keeps its own levels; anything else gets
-    // box mips built on load.
-    let (chain, _) = args.read.load_chain(&args.texture)?;
+    // box mips built on load. An array's layer is the one --layer picks.
+    let chain = if args.layer.is_some()
+        || matches!(
+            parvo::io::peek_kind(Path::new(&args.texture)),
+            Kind::Array { .. }
+        ) {
+        let loaded = args.read.load_environment(&args.texture)?;
+        let kind = loaded.info.kind;
+        if kind.is_cube() {
+            return Err(anyhow!(
+                "`{}` is a {}: look it up by direction with --direction",
+                args.texture,
+                kind.describe()
+            ));
+        }
+        let layer = pick_image(&args.texture, kind, args.layer)?;
+        loaded
+            .into_image_chain(layer)
+            .with_context(|| format!("cannot read texture `{}`", args.texture))?
+    } else {
+        args.read.load_chain(&args.texture)?.0
+    };
     if args.wrap.is_none() {
         // The wrap modes the file records (EXR/TIFF `wrapmodes`, parvo's
         // KTX2 key), as OpenImageIO's texture system uses them; repeat when
@@ -274,6 +312,50 @@ pub fn run(args: SampleArgs) -> Result<ExitCode> {
         Err(e) if is_broken_pipe(&e) => Ok(ExitCode::SUCCESS),
         Err(e) => Err(e),
         Ok(()) => Ok(ExitCode::SUCCESS),
+    }
+}
+
+/// The image `--layer` picks in `spec`, a texture of `kind`: for a 2-D
+/// array the layer, for a cube-map array the cube, as GL rounds an array
+/// coordinate ([`parvo::env::layer_index`]); 0 for one image. An array of
+/// more than one layer or cube without `--layer`, and `--layer` on a
+/// texture that is not an array, are refused saying why.
+pub(super) fn pick_image(spec: &str, kind: Kind, layer: Option<f32>) -> Result<usize> {
+    let (count, noun, what) = match kind {
+        Kind::Array { layers } => (
+            layers as usize,
+            "layer",
+            format!("a 2-D array of {layers} layers"),
+        ),
+        Kind::CubeArray { cubes } => (
+            cubes as usize,
+            "cube",
+            format!("a cube-map array of {cubes} cubes"),
+        ),
+        _ => {
+            let what = match kind {
+                Kind::Plain => "one 2-D image".to_string(),
+                Kind::Cube => "one cube map".to_string(),
+                Kind::LatLong => "a lat-long environment map".to_string(),
+                other => other.describe(),
+            };
+            return match layer {
+                None => Ok(0),
+                Some(_) => Err(anyhow!(
+                    "--layer picks a layer of a 2-D array (or, with --direction, a cube of a \
+                     cube-map array), and `{spec}` is {what}, not an array"
+                )),
+            };
+        }
+    };
+    match layer {
+        Some(l) => Ok(layer_index(l, count)),
+        None if count <= 1 => Ok(0),
+        None => Err(anyhow!(
+            "`{spec}` is {what}: say which {noun} to sample with --layer N, N from 0 to {} \
+             (rounded as GL rounds an array layer, clamped to that range)",
+            count - 1
+        )),
     }
 }
 

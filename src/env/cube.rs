@@ -494,25 +494,190 @@ pub(crate) fn check_faces(faces: &[MipChain]) -> Result<()> {
     Ok(())
 }
 
+/// How six square faces lie in one 2-D image: the strips and crosses
+/// cube-map tools export. A layout is told by the image's aspect ratio
+/// alone ([`CubeLayout::detect`]), as the four aspects differ.
+///
+/// Every face is stored as GL orients it (column `i` along `s`, row `j`
+/// along `t`, row 0 at the top of the image), except the vertical
+/// cross's −Z, turned 180°. The crosses are the cube unfolded so that
+/// texels on both sides of every border between two cells of the cross
+/// are neighbours on the cube too; this follows from GL's Table 8.19:
+/// `+Z` has `s` along +x and `t` along −y, so its right edge meets `+X`'s
+/// left edge (`s = 0` is `z = +1` there), `+X`'s right edge `−Z`'s left
+/// edge, `+Y`'s last row (`t = 1`, `z = +1`) `+Z`'s first row, and `−Y`'s
+/// first row (`t = 0`, `z = +1`) `+Z`'s last row. Below `−Y` (whose last
+/// row is `z = −1`) the unfolding continues onto `−Z` with +x to the
+/// right and +y downwards, which is GL's `−Z` turned 180°.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CubeLayout {
+    /// `w × 6w`: +X, −X, +Y, −Y, +Z, −Z from the top (OpenEXR's cube
+    /// map, as `maketx --envcube` writes it).
+    VerticalStrip,
+    /// `6w × w`: +X, −X, +Y, −Y, +Z, −Z from the left.
+    HorizontalStrip,
+    /// `4w × 3w`: −X, +Z, +X, −Z in the middle row, +Y above +Z and −Y
+    /// below it (AMD CubeMapGen's and cmft's cross).
+    HorizontalCross,
+    /// `3w × 4w`: −X, +Z, +X in the second row, +Y above +Z, −Y below it
+    /// and −Z below −Y, turned 180°.
+    VerticalCross,
+}
+
+impl CubeLayout {
+    /// Every layout, in the order error messages list them.
+    pub const ALL: [CubeLayout; 4] = [
+        CubeLayout::VerticalStrip,
+        CubeLayout::HorizontalStrip,
+        CubeLayout::HorizontalCross,
+        CubeLayout::VerticalCross,
+    ];
+
+    /// The image size, in faces across and down.
+    pub fn cells(self) -> (u32, u32) {
+        match self {
+            CubeLayout::VerticalStrip => (1, 6),
+            CubeLayout::HorizontalStrip => (6, 1),
+            CubeLayout::HorizontalCross => (4, 3),
+            CubeLayout::VerticalCross => (3, 4),
+        }
+    }
+
+    /// The layout of a `w × h` image and its face size, if its aspect is
+    /// one of the four.
+    pub fn detect(w: u32, h: u32) -> Option<(CubeLayout, u32)> {
+        CubeLayout::ALL
+            .into_iter()
+            .find_map(|l| l.face_size(w, h).map(|n| (l, n)))
+    }
+
+    /// The face size of a `w × h` image in this layout, if it is one.
+    pub fn face_size(self, w: u32, h: u32) -> Option<u32> {
+        let (a, b) = self.cells();
+        let n = w / a;
+        (n > 0 && w.is_multiple_of(a) && u64::from(h) == u64::from(n) * u64::from(b)).then_some(n)
+    }
+
+    /// Where face `f` (GL's order) lies: its cell's column and row, and
+    /// whether it is stored turned by 180°.
+    pub fn face_cell(self, f: usize) -> (u32, u32, bool) {
+        const CROSS: [(u32, u32); 6] = [(2, 1), (0, 1), (1, 0), (1, 2), (1, 1), (3, 1)];
+        let f = f.min(5);
+        match self {
+            CubeLayout::VerticalStrip => (0, f as u32, false),
+            CubeLayout::HorizontalStrip => (f as u32, 0, false),
+            CubeLayout::HorizontalCross => (CROSS[f].0, CROSS[f].1, false),
+            CubeLayout::VerticalCross if f == 5 => (1, 3, true),
+            CubeLayout::VerticalCross => (CROSS[f].0, CROSS[f].1, false),
+        }
+    }
+
+    /// The layout's name and shape, as messages print it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            CubeLayout::VerticalStrip => "a vertical strip w x 6w (+x -x +y -y +z -z from the top)",
+            CubeLayout::HorizontalStrip => {
+                "a horizontal strip 6w x w (+x -x +y -y +z -z from the left)"
+            }
+            CubeLayout::HorizontalCross => {
+                "a horizontal cross 4w x 3w (-x +z +x -z across, +y above and -y below +z)"
+            }
+            CubeLayout::VerticalCross => {
+                "a vertical cross 3w x 4w (-x +z +x across, +y above +z, -y below it, -z below -y \
+                 turned 180 degrees)"
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for CubeLayout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            CubeLayout::VerticalStrip => "vertical strip",
+            CubeLayout::HorizontalStrip => "horizontal strip",
+            CubeLayout::HorizontalCross => "horizontal cross",
+            CubeLayout::VerticalCross => "vertical cross",
+        })
+    }
+}
+
 /// The six faces of a vertical strip (`w × 6w`, faces +X, −X, +Y, −Y, +Z,
 /// −Z from the top: OpenEXR's cube-map layout, as `maketx --envcube`
 /// writes it), stored as the strip stores them.
 pub fn faces_from_strip(strip: &Texture) -> Result<Vec<Texture>> {
     let (w, h) = (strip.width(), strip.height());
-    if w == 0 || h != 6 * w {
+    if w == 0 || u64::from(h) != 6 * u64::from(w) {
         return Err(Error::InvalidOption(format!(
             "a cube-map strip is w x 6w (six square faces stacked, +x -x +y -y +z -z from the top), not {w}x{h}"
         )));
     }
-    let face_len = strip.texels().len() / 6;
-    let slice = |f: usize| match strip.texels() {
-        Texels::U8(v) => Texels::U8(v[f * face_len..(f + 1) * face_len].to_vec()),
-        Texels::U16(v) => Texels::U16(v[f * face_len..(f + 1) * face_len].to_vec()),
-        Texels::F16(v) => Texels::F16(v[f * face_len..(f + 1) * face_len].to_vec()),
-        Texels::F32(v) => Texels::F32(v[f * face_len..(f + 1) * face_len].to_vec()),
+    faces_in_layout(strip, CubeLayout::VerticalStrip)
+}
+
+/// The six faces of a strip or a cross, its layout told by its aspect
+/// ([`CubeLayout::detect`]); any other size is refused with the layouts
+/// that are read.
+pub fn faces_from_image(image: &Texture) -> Result<Vec<Texture>> {
+    let (w, h) = (image.width(), image.height());
+    match CubeLayout::detect(w, h) {
+        Some((layout, _)) => faces_in_layout(image, layout),
+        None => Err(Error::InvalidOption(format!(
+            "a {w}x{h} image is not six cube faces in a layout parvo reads: {}",
+            layouts_sentence()
+        ))),
+    }
+}
+
+/// The accepted layouts, one clause each (for messages).
+pub fn layouts_sentence() -> String {
+    CubeLayout::ALL
+        .iter()
+        .map(|l| l.describe())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The six faces (GL's order, GL's orientation) of `image` laid out as
+/// `layout`; the image's size must be the layout's multiple of one face.
+pub fn faces_in_layout(image: &Texture, layout: CubeLayout) -> Result<Vec<Texture>> {
+    let (w, h) = (image.width(), image.height());
+    let Some(n) = layout.face_size(w, h) else {
+        return Err(Error::InvalidOption(format!(
+            "a {w}x{h} image is not {}",
+            layout.describe()
+        )));
     };
+    let ch = image.channels();
+    fn cut<T: Copy>(v: &[T], w: usize, ch: usize, n: usize, cell: (u32, u32, bool)) -> Vec<T> {
+        let (x0, y0) = (cell.0 as usize * n, cell.1 as usize * n);
+        let mut out = Vec::with_capacity(n * n * ch);
+        for j in 0..n {
+            for i in 0..n {
+                // A face turned 180°: its texel (i, j) is the cell's
+                // (n-1-i, n-1-j).
+                let (x, y) = if cell.2 {
+                    (x0 + n - 1 - i, y0 + n - 1 - j)
+                } else {
+                    (x0 + i, y0 + j)
+                };
+                let at = (y * w + x) * ch;
+                out.extend_from_slice(&v[at..at + ch]);
+            }
+        }
+        out
+    }
+    let (wu, nu) = (w as usize, n as usize);
     (0..6)
-        .map(|f| Texture::from_texels(w, w, strip.format(), slice(f)))
+        .map(|f| {
+            let cell = layout.face_cell(f);
+            let texels = match image.texels() {
+                Texels::U8(v) => Texels::U8(cut(v, wu, ch, nu, cell)),
+                Texels::U16(v) => Texels::U16(cut(v, wu, ch, nu, cell)),
+                Texels::F16(v) => Texels::F16(cut(v, wu, ch, nu, cell)),
+                Texels::F32(v) => Texels::F32(cut(v, wu, ch, nu, cell)),
+            };
+            Texture::from_texels(n, n, image.format(), texels)
+        })
         .collect()
 }
 

@@ -145,6 +145,19 @@ pub(crate) fn grid_average(
     acc.map(|x| (x * s) as f32)
 }
 
+/// The layer (or, in a cube-map array, the cube) GL reads for array
+/// coordinate `layer` among `layers`: `clamp(floor(layer + 0.5), 0,
+/// layers − 1)`, so 1.6 reads layer 2 and 1.4 layer 1 (OpenGL 4.6 §8.14.2,
+/// Vulkan's "Cube Map Face Selection" for cube arrays); NaN reads layer 0,
+/// as does any layer of an empty array.
+pub fn layer_index(layer: f32, layers: usize) -> usize {
+    let l = (layer as f64 + 0.5).floor();
+    if l.is_nan() || layers == 0 {
+        return 0;
+    }
+    l.clamp(0.0, (layers - 1) as f64) as usize
+}
+
 /// A 2-D texture array: one sampler per layer, sharing options.
 #[derive(Clone, Debug)]
 pub struct ArraySampler {
@@ -186,14 +199,9 @@ impl ArraySampler {
         self.layers.len()
     }
 
-    /// The layer GL reads for array coordinate `layer`:
-    /// `clamp(floor(layer + 0.5), 0, layers − 1)` (NaN reads layer 0).
+    /// The layer GL reads for array coordinate `layer` ([`layer_index`]).
     pub fn layer_index(&self, layer: f32) -> usize {
-        let l = (layer as f64 + 0.5).floor();
-        if l.is_nan() {
-            return 0;
-        }
-        l.clamp(0.0, (self.layers.len() - 1) as f64) as usize
+        layer_index(layer, self.layers.len())
     }
 
     /// Filtered linear RGBA of layer `layer` (see [`Self::layer_index`]).

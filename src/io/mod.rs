@@ -228,18 +228,22 @@ impl Loaded {
         let options = self.chain_options();
         self.into_images()
             .into_iter()
-            .map(|levels| {
-                let mut levels = levels.into_iter();
-                match (levels.next(), levels.len()) {
-                    (Some(base), 0) => mip::build(base, &options),
-                    (Some(base), _) => MipChain::from_levels(
-                        std::iter::once(base).chain(levels).collect(),
-                        options,
-                    ),
-                    (None, _) => Err(Error::InvalidOption("an image without levels".into())),
-                }
-            })
+            .map(|levels| image_chain(levels, &options))
             .collect()
+    }
+
+    /// Face or layer `index` (in [`Loaded::into_images`]'s order) as a
+    /// mip chain, made as [`Loaded::into_image_chains`] makes each; the
+    /// other images are dropped without building their levels.
+    pub fn into_image_chain(self, index: usize) -> Result<MipChain> {
+        let options = self.chain_options();
+        let count = 1 + self.images.len();
+        let levels = self.into_images().into_iter().nth(index).ok_or_else(|| {
+            Error::InvalidOption(format!(
+                "image {index} asked for, and the file holds {count}"
+            ))
+        })?;
+        image_chain(levels, &options)
     }
 
     /// Level 0.
@@ -277,6 +281,18 @@ impl Loaded {
             mip::build(self.into_base(), &options)?
         };
         Ok((chain, blocks))
+    }
+}
+
+/// One image's chain: its own levels, or box levels built from level 0.
+fn image_chain(levels: Vec<Texture>, options: &MipOptions) -> Result<MipChain> {
+    let mut levels = levels.into_iter();
+    match (levels.next(), levels.len()) {
+        (Some(base), 0) => mip::build(base, options),
+        (Some(base), _) => {
+            MipChain::from_levels(std::iter::once(base).chain(levels).collect(), *options)
+        }
+        (None, _) => Err(Error::InvalidOption("an image without levels".into())),
     }
 }
 
