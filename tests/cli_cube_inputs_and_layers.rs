@@ -9,9 +9,10 @@
 //! do, with GL's rounding of the layer, and an array without `--layer`
 //! refused.
 
-use std::io::Write;
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::Output;
+
+mod cli_common;
 
 use parvo::env::cube::{CubeLayout, build_faces, faces_from_image};
 use parvo::env::{ArraySampler, CubeSampler, DirQuery, Kind};
@@ -21,20 +22,7 @@ use parvo::sample::{Filter, Query, Sampler, SamplerOptions};
 use parvo::{ChannelType, ColorSpace, Format, MipOptions, Texture};
 
 fn parvo(args: &[&str], stdin: &str) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_parvo"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(stdin.as_bytes())
-        .unwrap();
-    child.wait_with_output().unwrap()
+    cli_common::parvo_with_input(args, stdin)
 }
 
 fn ok(o: &Output, what: &str) {

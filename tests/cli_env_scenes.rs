@@ -5,24 +5,8 @@
 //! cube map is refused with a way to convert it, and on the sphere,
 //! anisotropic filtering is closer to the reference than trilinear.
 
-use std::process::{Command, Output};
-
-fn parvo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_parvo"))
-        .args(args)
-        .output()
-        .expect("run parvo")
-}
-
-fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+mod cli_common;
+use cli_common::{ok, parvo};
 
 #[test]
 fn cachesim_of_the_builtin_sky_equals_the_same_image_from_a_file() {

@@ -5,24 +5,8 @@
 //! `parvo render` writes frames of the requested size.
 
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn parvo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_parvo"))
-        .args(args)
-        .output()
-        .expect("run parvo")
-}
-
-fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+mod cli_common;
+use cli_common::{ok, parvo};
 
 fn report(dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap()

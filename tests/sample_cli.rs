@@ -1,24 +1,15 @@
 //! `parvo sample` end to end, on built-in textures.
 
-use std::io::Write;
-use std::process::{Command, Output, Stdio};
+use std::process::Output;
 
+mod cli_common;
+
+/// `parvo sample ARGS` with `stdin` as its input.
 fn run(args: &[&str], stdin: &str) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_parvo"))
-        .arg("sample")
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(stdin.as_bytes())
-        .unwrap();
-    child.wait_with_output().unwrap()
+    let all: Vec<&str> = std::iter::once("sample")
+        .chain(args.iter().copied())
+        .collect();
+    cli_common::parvo_with_input(&all, stdin)
 }
 
 fn lines(o: &Output) -> Vec<Vec<f32>> {
