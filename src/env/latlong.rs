@@ -55,6 +55,7 @@ use crate::texture::Texture;
 use crate::wrap::{Wrap, WrapMode};
 
 use super::DirQuery;
+use super::vec3::{add, unit};
 
 /// Levels at most this many texels wide and high fade to the pole colour
 /// near the poles (module docs).
@@ -300,25 +301,6 @@ fn st_query(d: [f64; 3], dx: [f64; 3], dy: [f64; 3]) -> Query {
         dsdy as f32,
         dtdy as f32,
     )
-}
-
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|c| a[c] + b[c])
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// `a` scaled to unit length (a zero or non-finite vector stays as it is:
-/// its `(s, t)` then reads 0 where NaN).
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    let l = dot(a, a).sqrt();
-    if l > 0.0 && l.is_finite() {
-        a.map(|c| c / l)
-    } else {
-        a
-    }
 }
 
 /// `a` scaled to unit length in `f32` (as OpenImageIO normalises).

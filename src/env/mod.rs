@@ -24,6 +24,7 @@ pub mod cube;
 mod cube_ewa;
 pub mod latlong;
 pub mod prefilter;
+pub(crate) mod vec3;
 
 pub use cube::CubeSampler;
 pub use latlong::LatLongSampler;

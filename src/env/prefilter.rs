@@ -50,6 +50,7 @@ use crate::texture::Texture;
 
 use super::DirQuery;
 use super::cube::{CubeSampler, face_direction};
+use super::vec3::{cross, unit};
 
 /// The lobe a prefiltered level is convolved with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -377,17 +378,4 @@ pub fn sh9_irradiance(coef: &[[f64; 3]; 9], n: [f64; 3]) -> [f64; 3] {
 
 fn rgba_f32() -> Format {
     Format::new(4, ChannelType::F32, ColorSpace::Linear)
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    a.map(|c| c / l)
 }

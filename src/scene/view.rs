@@ -14,6 +14,7 @@
 use super::plane::{PlaneCamera, PlaneGrid};
 use super::{Frame, Scene, Sky, Sphere, Tunnel, Zoom};
 use crate::env::latlong::direction_to_st;
+use crate::env::vec3::{cross, dot, unit};
 use crate::sample::Query;
 
 /// A [`Scene`] set up for one frame and level-0 texture size.
@@ -246,11 +247,7 @@ impl EnvView {
     fn camera(w: f64, h: f64, fov_y: f64, forward: [f64; 3], up: [f64; 3]) -> Self {
         let tan = (fov_y * 0.5).tan();
         // right = forward × up: +x on the screen turns towards larger s.
-        let right = [
-            forward[1] * up[2] - forward[2] * up[1],
-            forward[2] * up[0] - forward[0] * up[2],
-            forward[0] * up[1] - forward[1] * up[0],
-        ];
+        let right = cross(forward, up);
         EnvView {
             w,
             h,
@@ -283,10 +280,9 @@ impl EnvView {
     fn uv(&self, x: f64, y: f64) -> Option<(f64, f64)> {
         let nx = (x / self.w * 2.0 - 1.0) * self.sx;
         let ny = (1.0 - y / self.h * 2.0) * self.sy;
-        let d: [f64; 3] =
-            std::array::from_fn(|i| self.forward[i] + nx * self.right[i] + ny * self.up[i]);
-        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        let d = d.map(|c| c / len);
+        let d = unit(std::array::from_fn(|i| {
+            self.forward[i] + nx * self.right[i] + ny * self.up[i]
+        }));
         let Some(dist) = self.sphere else {
             return Some(direction_to_st(d));
         };
@@ -299,7 +295,7 @@ impl EnvView {
         }
         let t = -b - disc.sqrt();
         let n = [t * d[0], t * d[1], dist + t * d[2]];
-        let dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+        let dn = dot(d, n);
         Some(direction_to_st(std::array::from_fn(|i| {
             d[i] - 2.0 * dn * n[i]
         })))
