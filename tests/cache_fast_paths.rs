@@ -12,7 +12,7 @@ use std::sync::Arc;
 use parvo::cache::isotropic::AddressOnly;
 use parvo::cache::layout::{ChainLayout, Layout};
 use parvo::cache::reference::PlainSimulator;
-use parvo::cache::run::{AddressSink, Model, SAT_LEVEL, SceneSetup, unpack};
+use parvo::cache::run::{AddressSink, Job, Model, SAT_LEVEL, SceneSetup, unpack};
 use parvo::cache::shape::{self, CacheTexture};
 use parvo::cache::sim::{CacheConfig, Outcome};
 use parvo::sample::{Query, Sampler, SamplerOptions};
@@ -248,7 +248,7 @@ fn queries(seed: u64, n: usize) -> Vec<Query> {
 }
 
 /// The address-only isotropic lookups read what the traced sampler
-/// reads, read for read, for every magnification, minification and mip
+/// reads, read for read, one query at a time and a slice at once, for every magnification, minification and mip
 /// filter, every wrap mode on each axis, LOD bias and clamps, and level
 /// sizes down to one texel.
 #[test]
@@ -286,13 +286,20 @@ fn address_only_lookups_read_what_the_sampler_reads() {
                             o.wrap = Wrap { u: wu, v: wv };
                             let sampler = Sampler::new(chain, o).unwrap();
                             let a = AddressOnly::new(&sampler).unwrap();
+                            let mut every = Vec::new();
                             for q in &qs {
                                 let mut want = TexelRecorder::new();
                                 sampler.sample_traced(q, &mut want);
                                 let mut got = TexelRecorder::new();
                                 a.trace(q, &mut got);
                                 assert_eq!(got.reads, want.reads, "{o:?} {q:?}");
+                                every.extend(want.reads);
                             }
+                            // The whole slice at once (8 plans at a time
+                            // where the CPU can), in the same order.
+                            let mut all = TexelRecorder::new();
+                            a.trace_slice(&qs, &mut all);
+                            assert!(all.reads == every, "{o:?}: the slice's reads differ");
                             combinations += 1;
                         }
                     }
@@ -412,5 +419,126 @@ fn a_scene_run_equals_the_plain_model_on_a_one_by_one_trace() {
             assert_eq!((r.pixels, r.reads), (pixels, trace.len() as u64));
             assert_eq!((r.quads, r.prefetch.len()), (None, 0));
         }
+    }
+}
+
+/// Per level (index = level tag, the table's entries last) and in total:
+/// (accesses, hits, cold, capacity, conflict) of the plain model.
+fn plain_per_level(accesses: &[u64], cache: &CacheConfig, levels: usize) -> Vec<[u64; 5]> {
+    let mut sim = PlainSimulator::new(cache);
+    let mut c = vec![[0u64; 5]; levels + 1];
+    for &a in accesses {
+        let (addr, level) = unpack(a);
+        let k = if level == SAT_LEVEL {
+            levels
+        } else {
+            level as usize
+        };
+        for (_, o) in sim.access(addr, 4) {
+            c[k][0] += 1;
+            c[k][match o {
+                Outcome::Hit => 1,
+                Outcome::Cold => 2,
+                Outcome::Capacity => 3,
+                _ => 4,
+            }] += 1;
+        }
+    }
+    c
+}
+
+/// Runs keep reads of the last few distinct lines as counts (a window as
+/// long as the fewest ways of an all-LRU set of caches, one line
+/// otherwise): every counter of every level equals the plain model's on
+/// the one-by-one trace, for one cache and for a sweep of caches with
+/// mixed ways and policies, on frames of several sampling chunks (the
+/// window restarts at each chunk), and a second level sees the same
+/// misses as a run of the unmerged trace.
+#[test]
+fn merged_runs_count_what_the_plain_model_counts_per_level() {
+    let chain = loaded("builtin:checker:512");
+    let caches: Vec<CacheConfig> = [
+        "4K:64:4",
+        "2K:64:2",
+        "1K:64:1",
+        "2K:64:32",
+        "4K:32:8",
+        "2K:64:4:fifo",
+        "2K:64:4:random",
+        "8K:128:16",
+    ]
+    .iter()
+    .map(|c| c.parse().unwrap())
+    .collect();
+    let cases = [
+        ("trilinear", "plane", "tiled:4x4", "tiled:8", 211, 97),
+        ("trilinear", "rotate:23:1.7", "morton", "scanline", 190, 120),
+        ("bilinear", "zoom", "linear", "hilbert", 150, 130),
+        ("nearest", "plane", "tiled:8x2", "tiled:4", 200, 90),
+    ];
+    for (filter, scene, layout, order, w, h) in cases {
+        let sampler = Sampler::new(&chain, SamplerOptions::from_name(filter).unwrap()).unwrap();
+        let cl = ChainLayout::for_sampler(&chain, &sampler, layout.parse().unwrap());
+        let setup = SceneSetup {
+            sampler: &sampler,
+            layout: &cl,
+            scene: scene.parse::<Scene>().unwrap(),
+            frame: Frame::new(w, h),
+            order: order.parse().unwrap(),
+        };
+        assert!(w * h > 2 * 8192, "the frame spans several chunks");
+        let (trace, pixels) = trace_one_by_one(&setup);
+        let levels = chain.len();
+        let check = |r: &parvo::cache::run::RunStats, cache: &CacheConfig, what: &str| {
+            let want = plain_per_level(&trace, cache, levels);
+            for (k, c) in r.stats.per_level.iter().enumerate() {
+                assert_eq!(
+                    [c.accesses, c.hits, c.cold, c.capacity, c.conflict],
+                    want[k],
+                    "{what}: {filter} {scene} {layout} {order} {cache} level {k}"
+                );
+            }
+            let counted: u64 = r.stats.per_level.iter().map(|c| c.accesses).sum();
+            assert_eq!(counted, trace.len() as u64, "{what} {cache}");
+            assert_eq!((r.pixels, r.reads), (pixels, trace.len() as u64));
+        };
+        for cache in &caches {
+            let r = setup
+                .run(cache, None, &Model::default(), None, &|_, _| {})
+                .unwrap();
+            check(&r, cache, "one cache");
+        }
+        // Every cache at once (window: the fewest ways, or one line for
+        // the FIFO and random ones), and the LRU ones alone (window 4).
+        let layouts = [&cl];
+        for set in [&caches[..], &[caches[0], caches[3], caches[7]][..]] {
+            let jobs: Vec<Job> = set
+                .iter()
+                .map(|&l1| Job {
+                    layout: 0,
+                    l1,
+                    l2: None,
+                })
+                .collect();
+            let runs = setup
+                .run_jobs(&layouts, &jobs, &Model::default(), &|_, _| {})
+                .unwrap();
+            for (r, j) in runs.iter().zip(&jobs) {
+                check(r, &j.l1, "sweep");
+            }
+        }
+        // A second level behind a 4-way LRU first level.
+        let (l1, l2): (CacheConfig, CacheConfig) =
+            ("2K:64:4".parse().unwrap(), "16K:64:8".parse().unwrap());
+        let merged = setup
+            .run(&l1, Some(&l2), &Model::default(), None, &|_, _| {})
+            .unwrap();
+        let unmerged = setup
+            .simulate(&l1, Some(&l2), &mut |_| Ok(()), &|_, _| {})
+            .unwrap();
+        assert_eq!(
+            merged.stats, unmerged.stats,
+            "{filter} {scene}: with a second level"
+        );
     }
 }

@@ -33,6 +33,12 @@ pub struct AddressOnly {
     wrap: Wrap,
     /// Width, height, and both as `f64`, per level.
     levels: Vec<(u32, u32, f64, f64)>,
+    /// Whether [`AddressOnly::trace_all`] plans 8 queries at a time, and
+    /// with which mip mode (linear: `true`): on CPUs with the sampler's
+    /// AVX-512 paths, for mip mode nearest or linear and the same
+    /// magnification and minification filter.
+    #[cfg(target_arch = "x86_64")]
+    lanes: Option<(crate::sample::simd::Planner, bool)>,
 }
 
 impl AddressOnly {
@@ -50,11 +56,21 @@ impl AddressOnly {
             .map(|(w, h)| (w, h, w as f64, h as f64))
             .collect();
         let &(_, _, wf, hf) = levels.first()?;
+        #[cfg(target_arch = "x86_64")]
+        let lanes = crate::sample::simd::Planner::new()
+            .filter(|_| o.mag == o.min)
+            .and_then(|p| match o.mip {
+                MipMode::Linear => Some((p, true)),
+                MipMode::Nearest => Some((p, false)),
+                MipMode::None => None,
+            });
         Some(AddressOnly {
             lod: Lod::new(&o, wf, hf, levels.len()),
             options: o,
             wrap: o.wrap,
             levels,
+            #[cfg(target_arch = "x86_64")]
+            lanes,
         })
     }
 
@@ -63,6 +79,43 @@ impl AddressOnly {
     #[inline]
     pub fn trace<S: TexelSink>(&self, q: &Query, sink: &mut S) {
         self.trace_blocks(q, &mut Texels(sink));
+    }
+
+    /// [`AddressOnly::trace`] of every query of `qs` in order (see
+    /// [`AddressOnly::trace_all`]).
+    pub fn trace_slice<S: TexelSink>(&self, qs: &[Query], sink: &mut S) {
+        self.trace_all(qs, &mut Texels(sink));
+    }
+
+    /// [`AddressOnly::trace_blocks`] of every query of `qs` in order:
+    /// on CPUs with the sampler's AVX-512 paths, the level plans and
+    /// wrapped coordinates of 8 queries at a time in registers (the same
+    /// operations, so the same reads; the lanes those do not cover, and
+    /// the last few queries, one by one).
+    #[inline]
+    pub(crate) fn trace_all<S: BlockSink>(&self, qs: &[Query], sink: &mut S) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some((planner, linear)) = self.lanes {
+            let (q8s, rest) = qs.as_chunks::<8>();
+            for q8 in q8s {
+                let p = planner.plans8(&self.lod, &self.options, linear, q8);
+                for (i, q) in q8.iter().enumerate() {
+                    if p.exact >> i & 1 == 0 {
+                        self.trace_blocks(q, sink);
+                        continue;
+                    }
+                    let (hi, lo) = (p.hi[i] as usize, p.lo[i] as usize);
+                    // The filters are the same either way (`lanes`).
+                    self.filter(false, hi, p.u[i], p.v[i], sink);
+                    if p.delta[i] > 0.0 && lo != hi {
+                        self.filter(false, lo, p.u[i], p.v[i], sink);
+                    }
+                }
+            }
+            rest.iter().for_each(|q| self.trace_blocks(q, sink));
+            return;
+        }
+        qs.iter().for_each(|q| self.trace_blocks(q, sink));
     }
 
     /// [`AddressOnly::trace`] to a sink that takes a bilinear block at

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use super::isotropic::{AddressOnly, BlockSink};
 use super::layout::ChainLayout;
 use super::prefetch::{Prefetch, PrefetchStats, Timing};
-use super::sim::{AddressSpace, CacheConfig, Outcome, Simulator, Stats};
+use super::sim::{AddressSpace, CacheConfig, Outcome, Policy, Simulator, Stats};
 use crate::error::{Error, Result};
 use crate::sample::{Query, Sampler, TexelSink};
 use crate::scene::{Frame, RasterOrder, Scene, View};
@@ -75,51 +75,175 @@ impl TexelSink for AddressSink<'_> {
     }
 }
 
-/// The recording sink of a traced frame: each read's address in every
-/// layout (a sweep traces its frame once for all of them), and, when
-/// `merge` is set, consecutive reads of one line (lines of `1 << merge`
-/// bytes) at one level kept as one entry with a count: the simulator then
-/// takes the repeats as the hits they are without looking them up.
-/// `ONE` is the common case of one layout, compiled without the loop.
-struct Recorder<'a, const ONE: bool> {
-    layouts: &'a [&'a ChainLayout],
-    merge: Option<u32>,
-    out: Vec<Vec<u64>>,
-    counts: Vec<Vec<u32>>,
+/// How the [`Recorder`] may keep reads as fewer entries: lines of
+/// `1 << shift` bytes, and a window of the last `window` distinct lines
+/// (see [`Window`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Merge {
+    shift: u32,
+    window: usize,
 }
 
-impl<'a, const ONE: bool> Recorder<'a, ONE> {
-    fn new(layouts: &'a [&'a ChainLayout], merge: Option<u32>, reserve: usize) -> Self {
-        let n = layouts.len();
-        Recorder {
-            layouts,
-            merge,
-            out: (0..n).map(|_| Vec::with_capacity(reserve)).collect(),
-            counts: (0..n)
-                .map(|_| Vec::with_capacity(if merge.is_some() { reserve } else { 0 }))
-                .collect(),
+/// The longest window a [`Merge`] uses.
+const MAX_WINDOW: usize = 4;
+
+/// The last few distinct lines one layout's reads touched, most recent
+/// first, for [`Recorder`].
+///
+/// Every line in the window was read since the oldest of them was, so at
+/// most `window` distinct lines were read since any of them was last read:
+/// in an LRU cache of at least `window` ways (and in the fully associative
+/// shadow, which is larger) each is still present, and a read of one of
+/// them is a hit. A hit changes no counts but the hits, only the recency
+/// order of the lines read; so such reads are counted (`pending`) instead
+/// of recorded, and before the next read of a line outside the window the
+/// lines read meanwhile are recorded once each, least recent first (the
+/// lines of the window not read meanwhile are older than all of them):
+/// the cache then holds its lines in the order the full sequence leaves.
+/// With a window of one this is the merging of consecutive reads of one
+/// line, which is a hit that changes nothing under every policy.
+#[derive(Clone, Copy, Debug, Default)]
+struct Window {
+    len: usize,
+    line: [u64; MAX_WINDOW],
+    /// The packed access recorded for the line (its first read).
+    entry: [u64; MAX_WINDOW],
+    /// Reads of the line since it was last recorded.
+    pending: [u32; MAX_WINDOW],
+}
+
+impl Window {
+    /// Record the lines with pending reads, least recent first.
+    #[inline(always)]
+    fn flush(&mut self, out: &mut Vec<u64>, counts: &mut Vec<u32>) {
+        for p in (0..self.len).rev() {
+            if self.pending[p] > 0 {
+                out.push(self.entry[p]);
+                counts.push(self.pending[p]);
+                self.pending[p] = 0;
+            }
         }
     }
 
+    /// Make position `p` the most recent.
     #[inline(always)]
-    fn put(&mut self, i: usize, a: u64, mergeable: bool) {
+    fn raise(&mut self, p: usize) {
+        let (l, e, n) = (self.line[p], self.entry[p], self.pending[p]);
+        for k in (0..p).rev() {
+            self.line[k + 1] = self.line[k];
+            self.entry[k + 1] = self.entry[k];
+            self.pending[k + 1] = self.pending[k];
+        }
+        (self.line[0], self.entry[0], self.pending[0]) = (l, e, n);
+    }
+
+    /// A line just recorded (nothing pending), the least recent line
+    /// leaving a full window of `size`.
+    #[inline(always)]
+    fn insert(&mut self, line: u64, entry: u64, size: usize) {
+        self.len = (self.len + 1).min(size);
+        self.raise(self.len - 1);
+        (self.line[0], self.entry[0], self.pending[0]) = (line, entry, 0);
+    }
+}
+
+/// The recording sink of a traced frame: each read's address in every
+/// layout (a sweep traces its frame once for all of them), and, when
+/// `merge` is set, reads of lines in the window of the last few distinct
+/// lines kept as counts on fewer entries (see [`Window`]): the simulator
+/// then takes those reads as the hits they are without looking them up.
+/// `ONE` is the common case of one layout, compiled without the loop.
+struct Recorder<'a, const ONE: bool> {
+    layouts: &'a [&'a ChainLayout],
+    merge: Option<Merge>,
+    out: Vec<Vec<u64>>,
+    counts: Vec<Vec<u32>>,
+    windows: Vec<Window>,
+}
+
+impl<'a, const ONE: bool> Recorder<'a, ONE> {
+    /// A recorder into `reuse`'s vectors (emptied) when given, else into
+    /// new ones of `reserve` entries.
+    fn new(
+        layouts: &'a [&'a ChainLayout],
+        merge: Option<Merge>,
+        reserve: usize,
+        reuse: Option<Buffers>,
+    ) -> Self {
+        let n = layouts.len();
+        let (mut out, mut counts) = reuse.map_or_else(Default::default, |b| (b.out, b.counts));
+        out.resize_with(n, || Vec::with_capacity(reserve));
+        counts.resize_with(n, || {
+            Vec::with_capacity(if merge.is_some() { reserve } else { 0 })
+        });
+        out.iter_mut().for_each(Vec::clear);
+        counts.iter_mut().for_each(Vec::clear);
+        Recorder {
+            layouts,
+            merge,
+            out,
+            counts,
+            windows: vec![Window::default(); n],
+        }
+    }
+
+    /// `n` reads of the line of packed access `a` in layout `i`
+    /// (`mergeable`: a texel, not a table entry).
+    #[inline(always)]
+    fn put(&mut self, i: usize, a: u64, n: u32, mergeable: bool) {
         let out = &mut self.out[i];
-        if let Some(shift) = self.merge {
-            let counts = &mut self.counts[i];
-            if let (true, Some(&last), Some(n)) = (mergeable, out.last(), counts.last_mut())
-                && last >> shift == a >> shift
-            {
-                *n += 1;
+        let Some(m) = self.merge else {
+            out.push(a);
+            return;
+        };
+        let counts = &mut self.counts[i];
+        let w = &mut self.windows[i];
+        let line = a >> m.shift;
+        if mergeable && w.len > 0 {
+            if w.line[0] == line {
+                // Nothing pending: the line's entry is the last one.
+                match counts.last_mut() {
+                    Some(c) if w.pending[0] == 0 => *c += n,
+                    _ => w.pending[0] += n,
+                }
                 return;
             }
-            counts.push(1);
+            if let Some(p) = (1..w.len).find(|&p| w.line[p] == line) {
+                w.raise(p);
+                w.pending[0] += n;
+                return;
+            }
         }
+        w.flush(out, counts);
         out.push(a);
+        counts.push(n);
+        if mergeable {
+            w.insert(line, a, m.window);
+        } else {
+            // A read outside the window's reckoning: start it afresh.
+            w.len = 0;
+        }
     }
 
     /// Reads recorded so far (without merging).
     fn len(&self) -> usize {
         self.out.first().map_or(0, Vec::len)
+    }
+
+    /// The entries and counts, every pending read recorded.
+    fn finish(mut self) -> (Vec<Vec<u64>>, Vec<Vec<u32>>) {
+        if self.merge.is_none() {
+            return (self.out, Vec::new());
+        }
+        for ((w, out), counts) in self
+            .windows
+            .iter_mut()
+            .zip(&mut self.out)
+            .zip(&mut self.counts)
+        {
+            w.flush(out, counts);
+        }
+        (self.out, self.counts)
     }
 }
 
@@ -132,14 +256,10 @@ impl<const ONE: bool> BlockSink for Recorder<'_, ONE> {
         if ONE && let Some((a, dx, dy)) = self.layouts[0].block_steps(level, x, y) {
             let packed = [a, a + dx, a + dy, a + dx + dy].map(|a| pack(a, level));
             match self.merge {
-                Some(shift) if packed[0] >> shift == packed[3] >> shift => {
-                    self.put(0, packed[0], true);
-                    // `put` of one line just made or grew the last entry.
-                    if let Some(n) = self.counts[0].last_mut() {
-                        *n += 3;
-                    }
+                Some(m) if packed[0] >> m.shift == packed[3] >> m.shift => {
+                    self.put(0, packed[0], 4, true);
                 }
-                _ => packed.into_iter().for_each(|p| self.put(0, p, true)),
+                _ => packed.into_iter().for_each(|p| self.put(0, p, 1, true)),
             }
             return;
         }
@@ -155,11 +275,11 @@ impl<const ONE: bool> TexelSink for Recorder<'_, ONE> {
     fn texel(&mut self, level: u32, x: u32, y: u32) {
         if ONE {
             let a = pack(self.layouts[0].address(level, x, y), level);
-            self.put(0, a, true);
+            self.put(0, a, 1, true);
         } else {
             for i in 0..self.layouts.len() {
                 let a = pack(self.layouts[i].address(level, x, y), level);
-                self.put(i, a, true);
+                self.put(i, a, 1, true);
             }
         }
     }
@@ -167,7 +287,7 @@ impl<const ONE: bool> TexelSink for Recorder<'_, ONE> {
     fn sat_entry(&mut self, x: u32, y: u32) {
         for i in 0..self.layouts.len() {
             if let Some(a) = self.layouts[i].sat_address(x, y) {
-                self.put(i, pack(a, SAT_LEVEL), false);
+                self.put(i, pack(a, SAT_LEVEL), 1, false);
             }
         }
     }
@@ -249,7 +369,7 @@ impl SceneSetup<'_> {
         let units = tracer.units();
         let chunks: Vec<Chunk> = units
             .par_chunks(CHUNK)
-            .map(|c| tracer.produce(c, None))
+            .map(|c| tracer.produce(c, None, None))
             .collect();
         let n = chunks.iter().map(|c| c.accesses[0].len()).sum();
         let mut accesses = Vec::with_capacity(n);
@@ -369,6 +489,12 @@ impl Issue {
     }
 }
 
+/// The vectors of a consumed [`Chunk`], for the next one to record into.
+struct Buffers {
+    out: Vec<Vec<u64>>,
+    counts: Vec<Vec<u32>>,
+}
+
 /// A sampled piece of the frame: per layout the packed accesses, the end
 /// of each fragment in them (empty for [`Issue::Stream`]), the pixels
 /// that issued a query and the pixels or quads visited.
@@ -404,14 +530,19 @@ impl Tracer<'_> {
         }
     }
 
-    /// Sample `units` (pixels or quads); `merge`: see [`Recorder`].
-    fn produce(&self, units: &[(u32, u32)], merge: Option<u32>) -> Chunk {
+    /// Sample `units` (pixels or quads); `merge`: see [`Recorder`];
+    /// `reuse`: the vectors of a consumed chunk, to record into.
+    fn produce(&self, units: &[(u32, u32)], merge: Option<Merge>, reuse: Option<Buffers>) -> Chunk {
         // About eight reads per pixel (trilinear) to start with.
         let reserve = units.len() * if self.issue == Issue::Quads { 32 } else { 8 };
-        if self.layouts.len() == 1 {
-            self.produce_into(units, Recorder::<true>::new(self.layouts, merge, reserve))
+        let layouts = self.layouts;
+        if layouts.len() == 1 {
+            self.produce_into(units, Recorder::<true>::new(layouts, merge, reserve, reuse))
         } else {
-            self.produce_into(units, Recorder::<false>::new(self.layouts, merge, reserve))
+            self.produce_into(
+                units,
+                Recorder::<false>::new(layouts, merge, reserve, reuse),
+            )
         }
     }
 
@@ -460,13 +591,10 @@ impl Tracer<'_> {
                 }
             }
         }
+        let (accesses, counts) = sink.finish();
         Chunk {
-            accesses: sink.out,
-            counts: if sink.merge.is_some() {
-                sink.counts
-            } else {
-                Vec::new()
-            },
+            accesses,
+            counts,
             ends,
             pixels,
             units: units.len() as u64,
@@ -478,9 +606,7 @@ impl Tracer<'_> {
     #[inline]
     fn trace<S: BlockSink>(&self, qs: &[Query], colours: &mut Vec<[f32; 4]>, sink: &mut S) {
         if let Some(a) = &self.address_only {
-            for q in qs {
-                a.trace_blocks(q, sink);
-            }
+            a.trace_all(qs, sink);
             return;
         }
         colours.resize(qs.len(), [0.0; 4]);
@@ -490,17 +616,28 @@ impl Tracer<'_> {
             .sample_slice_traced(qs, &mut colours[..qs.len()], sink);
     }
 
-    /// The line size (as a shift) at which consecutive reads may be kept
-    /// as one entry for `jobs` (see [`Recorder`]): the smallest line of
-    /// their first levels, when a texel read lies within one line and no
-    /// cache has sectors (whose repeats may want other sectors), and the
-    /// reads are neither written out nor grouped into fragments.
-    fn merge_shift(&self, jobs: &[Job], writing: bool) -> Option<u32> {
+    /// How reads may be kept as fewer entries for `jobs` (see
+    /// [`Recorder`]): lines of the smallest line of their first levels,
+    /// when a texel read lies within one line and no cache has sectors
+    /// (whose repeats may want other sectors), and the reads are neither
+    /// written out nor grouped into fragments; a window of as many lines
+    /// as the fewest ways when every first level is LRU (up to
+    /// [`MAX_WINDOW`]), else of one line (only consecutive reads of a line
+    /// merge: a hit to the line just read changes no policy's state).
+    fn merge(&self, jobs: &[Job], writing: bool) -> Option<Merge> {
         let line = jobs.iter().map(|j| j.l1.line).min()?;
         let texel = self.layouts.iter().map(|l| l.texel()).max()?;
         let plain = jobs.iter().all(|j| j.l1.sector.is_none());
-        (self.issue == Issue::Stream && !writing && plain && texel <= line)
-            .then(|| line.trailing_zeros())
+        let lru = jobs.iter().all(|j| j.l1.policy == Policy::Lru);
+        let ways = jobs.iter().map(|j| j.l1.ways).min()?;
+        (self.issue == Issue::Stream && !writing && plain && texel <= line).then(|| Merge {
+            shift: line.trailing_zeros(),
+            window: if lru {
+                (ways as usize).clamp(1, MAX_WINDOW)
+            } else {
+                1
+            },
+        })
     }
 
     /// Sample the frame in groups (on the pool) and feed every group to
@@ -516,7 +653,7 @@ impl Tracer<'_> {
             .iter()
             .map(|j| Consumer::new(j, self.layouts[j.layout], model))
             .collect::<Result<Vec<_>>>()?;
-        let merge = self.merge_shift(jobs, each.is_some());
+        let merge = self.merge(jobs, each.is_some());
         let units = self.units();
         let total = units.len() as u64;
         let mut done = 0u64;
@@ -528,6 +665,7 @@ impl Tracer<'_> {
             CHUNK * 8
         };
         let groups: Vec<&[(u32, u32)]> = units.chunks(group).collect();
+        let spare = std::sync::Mutex::new(Vec::<Buffers>::new());
         // Sampling (on the pool) overlaps simulation (here), unless this
         // is a pool thread: see crate::par.
         crate::par::produce_consume(
@@ -535,7 +673,7 @@ impl Tracer<'_> {
             2,
             |_, g| -> Vec<Chunk> {
                 g.par_chunks(CHUNK)
-                    .map(|c| self.produce(c, merge))
+                    .map(|c| self.produce(c, merge, spare.lock().ok().and_then(|mut v| v.pop())))
                     .collect()
             },
             |_, chunks| -> Result<()> {
@@ -550,6 +688,14 @@ impl Tracer<'_> {
                 }
                 done += chunks.iter().map(|c| c.units).sum::<u64>();
                 progress(done, total);
+                // The next chunks record into these vectors: no new pages
+                // to fault in and zero for every chunk.
+                if let Ok(mut v) = spare.lock() {
+                    v.extend(chunks.into_iter().map(|c| Buffers {
+                        out: c.accesses,
+                        counts: c.counts,
+                    }));
+                }
                 Ok(())
             },
         )?;

@@ -88,7 +88,7 @@ pub mod gl;
 mod one;
 mod query;
 #[cfg(target_arch = "x86_64")]
-mod simd;
+pub(crate) mod simd;
 mod supersample;
 pub mod trace;
 mod trilinear;

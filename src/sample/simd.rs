@@ -1095,6 +1095,85 @@ pub(crate) unsafe fn nearest<P: Pixel, const MIP: u8>(
     }
 }
 
+/// The level plans and wrapped coordinates of 8 isotropic lookups, for
+/// tracing their reads without their texels
+/// ([`crate::cache::isotropic::AddressOnly`]): per lane `(u, v)` as
+/// `Lod::reduce` moves them, the levels `hi` and `lo` and the blend δ as
+/// `Lod::plan_nearest` (`MIP` nearest) or `Plan::at(Lod::lambda, …)`
+/// (`MIP` linear) give them, and the lanes computed exactly here (a
+/// normal ρ², coordinates below 2^51); the others need the portable
+/// plan. Whether a lane magnifies is not given: the caller's
+/// magnification and minification filters are the same.
+pub(crate) struct Plans8 {
+    pub u: [f64; 8],
+    pub v: [f64; 8],
+    pub hi: [i64; 8],
+    pub lo: [i64; 8],
+    pub delta: [f32; 8],
+    pub exact: u8,
+}
+
+/// Proof that the CPU has the features of [`available`]: the safe way to
+/// [`Planner::plans8`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Planner(());
+
+impl Planner {
+    /// A planner when the CPU has the features (and `PARVO_NO_AVX` is not
+    /// set).
+    pub(crate) fn new() -> Option<Planner> {
+        available().then_some(Planner(()))
+    }
+
+    /// [`Plans8`] of `q8` for `linear` (else nearest) mip mode.
+    #[inline]
+    pub(crate) fn plans8(
+        self,
+        lod: &Lod,
+        o: &SamplerOptions,
+        linear: bool,
+        q8: &[Query; 8],
+    ) -> Plans8 {
+        // SAFETY: a `Planner` exists only on CPUs with the features.
+        unsafe { plans8(lod, o, linear, q8) }
+    }
+}
+
+/// [`Plans8`] of `q8` for `linear` (else nearest) mip mode.
+///
+/// # Safety
+/// The CPU has the features of [`available`].
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx512vbmi")]
+unsafe fn plans8(lod: &Lod, o: &SamplerOptions, linear: bool, q8: &[Query; 8]) -> Plans8 {
+    let f = fields(q8);
+    let (hi, lo, delta, ok) = if linear {
+        plans::<MIP_LINEAR>(lod, o, &f)
+    } else {
+        plans::<MIP_NEAREST>(lod, o, &f)
+    };
+    let limit = _mm512_set1_pd(REDUCE_EXACT);
+    let small = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(f[0]), limit)
+        & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(_mm512_abs_pd(f[1]), limit);
+    let mut p = Plans8 {
+        u: [0.0; 8],
+        v: [0.0; 8],
+        hi: [0; 8],
+        lo: [0; 8],
+        delta: [0.0; 8],
+        exact: ok & small,
+    };
+    // SAFETY: unaligned stores of whole registers into arrays of their
+    // size.
+    unsafe {
+        _mm512_storeu_pd(p.u.as_mut_ptr(), reduce_lanes(f[0], lod.wrap_u));
+        _mm512_storeu_pd(p.v.as_mut_ptr(), reduce_lanes(f[1], lod.wrap_v));
+        _mm512_storeu_epi64(p.hi.as_mut_ptr(), hi);
+        _mm512_storeu_epi64(p.lo.as_mut_ptr(), lo);
+        _mm256_storeu_ps(p.delta.as_mut_ptr(), delta);
+    }
+    p
+}
+
 /// Below this magnitude `reduce_lanes` equals `Lod::reduce` (both floors
 /// exact): 2^51.
 const REDUCE_EXACT: f64 = 2_251_799_813_685_248.0;
