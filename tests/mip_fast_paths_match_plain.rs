@@ -95,6 +95,7 @@ fn fast_box_paths_match_the_plain_path_and_the_reference() {
 }
 
 /// Largest difference in 8-bit codes between two textures.
+#[cfg(feature = "io")]
 fn max_code_diff(a: &parvo::Texture, b: &parvo::Texture) -> u8 {
     let (parvo::Texels::U8(x), parvo::Texels::U8(y)) = (a.texels(), b.texels()) else {
         panic!("8-bit textures only")
@@ -112,6 +113,7 @@ fn max_code_diff(a: &parvo::Texture, b: &parvo::Texture) -> u8 {
 /// sizes whose rows end in a partial block of the kernel and whose levels
 /// stop halving early, and to odd sizes.
 #[test]
+#[cfg(feature = "io")]
 fn rgba8_srgb_box_chains_match_the_plain_path_on_real_photos() {
     for name in ["hopper.png", "pil123rgba.png"] {
         let path = format!(
