@@ -93,3 +93,77 @@ fn fast_box_paths_match_the_plain_path_and_the_reference() {
         }
     }
 }
+
+/// Largest difference in 8-bit codes between two textures.
+#[cfg(feature = "io")]
+fn max_code_diff(a: &parvo::Texture, b: &parvo::Texture) -> u8 {
+    let (parvo::Texels::U8(x), parvo::Texels::U8(y)) = (a.texels(), b.texels()) else {
+        panic!("8-bit textures only")
+    };
+    x.iter()
+        .zip(y)
+        .map(|(p, q)| p.abs_diff(*q))
+        .max()
+        .unwrap_or(0)
+}
+
+/// The RGBA8 sRGB box chain (level 1 fused from the codes where AVX-512
+/// runs) within one code of the plain path at every level, on real photos
+/// (opaque `hopper.png`, and `pil123rgba.png` with real alpha) cut to
+/// sizes whose rows end in a partial block of the kernel and whose levels
+/// stop halving early, and to odd sizes.
+#[test]
+#[cfg(feature = "io")]
+fn rgba8_srgb_box_chains_match_the_plain_path_on_real_photos() {
+    for name in ["hopper.png", "pil123rgba.png"] {
+        let path = format!(
+            "{}/tests/data/peer/pillow/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let l = parvo::io::load(&path, &parvo::io::Limits::default()).unwrap();
+        let tex = l.base();
+        let (w, h, ch) = (
+            tex.width() as usize,
+            tex.height() as usize,
+            tex.format().channels as usize,
+        );
+        let parvo::Texels::U8(v) = tex.texels() else {
+            panic!("{name} is 8-bit")
+        };
+        let rgba: Vec<u8> = v
+            .chunks_exact(ch)
+            .flat_map(|t| match ch {
+                4 => [t[0], t[1], t[2], t[3]],
+                3 => [t[0], t[1], t[2], 255],
+                _ => panic!("{name}: {ch} channels"),
+            })
+            .collect();
+        let f = Format::new(4, ChannelType::U8, ColorSpace::Srgb);
+        for (cw, chh) in [
+            (w, h),
+            (w - w % 4 - 28, 48),
+            (w - 1 - w % 2, h - 2 + h % 2),
+            (36, 24),
+        ] {
+            let mut cut = Vec::new();
+            for y in 0..chh {
+                cut.extend_from_slice(&rgba[y * w * 4..][..cw * 4]);
+            }
+            let t = parvo::Texture::from_u8(cw as u32, chh as u32, f, cut).unwrap();
+            let fast = mip::build(t.clone(), &MipOptions::default()).unwrap();
+            let plain = mip::build(
+                t,
+                &MipOptions {
+                    fast_paths: false,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            assert_eq!(fast.len(), plain.len());
+            for (k, (a, b)) in fast.levels().iter().zip(plain.levels()).enumerate() {
+                let d = max_code_diff(a, b);
+                assert!(d <= 1, "{name} {cw}x{chh} level {k}: {d} codes");
+            }
+        }
+    }
+}

@@ -31,6 +31,55 @@ pub(crate) struct Expanded {
     pad: usize,
     weights: Vec<f32>,
     pattern: Vec<u32>,
+    /// RGBA only: the longest stretch of destination texels that step
+    /// two source texels each with one weight pattern (the interior of a
+    /// 2:1 reduction), filtered four texels per register ([`Stride2`]).
+    stride2: Option<Stride2>,
+}
+
+/// Destination texels `x0..x1` whose taps start at source texel
+/// `first + 2·(x − x0)` and share the weights `w`: four destination
+/// texels fill one zmm register, so each tap is one fused multiply-add of
+/// a register of four source texels (picked from two loads by one
+/// permute) with a broadcast weight; no per-texel fold.
+#[derive(Clone, Debug)]
+struct Stride2 {
+    x0: usize,
+    x1: usize,
+    first: usize,
+    w: Vec<f32>,
+}
+
+impl Stride2 {
+    fn new(wx: &AxisWeights, pattern: &[u32]) -> Option<Stride2> {
+        let runs = wx.contiguous_runs();
+        let mut best: Option<(usize, usize)> = None;
+        let mut x = 0;
+        while x < runs.len() {
+            let Some(r) = runs[x] else {
+                x += 1;
+                continue;
+            };
+            let mut end = x + 1;
+            while end < runs.len()
+                && runs[end] == Some(r + 2 * (end - x) as u32)
+                && pattern[end] == pattern[x]
+            {
+                end += 1;
+            }
+            if best.is_none_or(|(a, b)| end - x > b - a) {
+                best = Some((x, end));
+            }
+            x = end;
+        }
+        let (x0, x1) = best.filter(|&(a, b)| b - a >= 8 && wx.taps <= 32)?;
+        Some(Stride2 {
+            x0,
+            x1,
+            first: runs[x0]? as usize,
+            w: wx.weight[x0 * wx.taps..][..wx.taps].to_vec(),
+        })
+    }
 }
 
 impl Expanded {
@@ -53,10 +102,16 @@ impl Expanded {
             });
             pattern.push(id);
         }
+        let stride2 = if ch == 4 {
+            Stride2::new(wx, &pattern)
+        } else {
+            None
+        };
         Expanded {
             pad,
             weights,
             pattern,
+            stride2,
         }
     }
 }
@@ -111,7 +166,7 @@ fn texel_by_index(tmp: &[f32], d: &mut [f32], wx: &AxisWeights, x: usize, ch: us
 pub(crate) mod x86 {
     use std::arch::x86_64::*;
 
-    use super::{Expanded, texel_by_index};
+    use super::{Expanded, Stride2, texel_by_index};
     use crate::mip::weights::AxisWeights;
 
     #[target_feature(enable = "avx512f,avx512vl,avx512dq,fma")]
@@ -125,12 +180,79 @@ pub(crate) mod x86 {
         ch: usize,
     ) {
         vertical(rows, tmp);
+        let all = 0..dst.len() / ch.max(1);
         match ch {
-            1 => horizontal::<1>(tmp, dst, wx, runs, ex),
-            2 => horizontal::<2>(tmp, dst, wx, runs, ex),
-            3 => horizontal::<3>(tmp, dst, wx, runs, ex),
-            _ => horizontal::<4>(tmp, dst, wx, runs, ex),
+            1 => horizontal::<1>(tmp, dst, wx, runs, ex, all),
+            2 => horizontal::<2>(tmp, dst, wx, runs, ex, all),
+            3 => horizontal::<3>(tmp, dst, wx, runs, ex, all),
+            _ => {
+                let (a, b) = match &ex.stride2 {
+                    Some(p) => stride2(tmp, dst, p),
+                    None => (0, 0),
+                };
+                horizontal::<4>(tmp, dst, wx, runs, ex, 0..a);
+                horizontal::<4>(tmp, dst, wx, runs, ex, b..all.end);
+            }
         }
+    }
+
+    /// The texels of `p` four at a time (see [`Stride2`]), as far as
+    /// their loads stay inside the row; returns the range done.
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq,fma")]
+    fn stride2(tmp: &[f32], dst: &mut [f32], p: &Stride2) -> (usize, usize) {
+        let taps = p.w.len();
+        let mut w = [_mm512_setzero_ps(); 32];
+        for (r, &v) in w.iter_mut().zip(&p.w) {
+            *r = _mm512_set1_ps(v);
+        }
+        // Texels 0, 2 of two loads (tap 2u) or 1, 3 (tap 2u + 1).
+        let pick = |odd: i32| {
+            let o = 4 * odd;
+            _mm512_setr_epi32(
+                o,
+                o + 1,
+                o + 2,
+                o + 3,
+                o + 8,
+                o + 9,
+                o + 10,
+                o + 11,
+                o + 16,
+                o + 17,
+                o + 18,
+                o + 19,
+                o + 24,
+                o + 25,
+                o + 26,
+                o + 27,
+            )
+        };
+        let (even, odd) = (pick(0), pick(1));
+        let sw = tmp.len() / 4;
+        // The last texel a group reads: load u + 2 of the last tap pair.
+        let reach = 2 * ((taps - 1) / 2 + 2) + 4;
+        let mut x = p.x0;
+        while x + 4 <= p.x1 && p.first + 2 * (x - p.x0) + reach <= sw {
+            let i0 = p.first + 2 * (x - p.x0);
+            let mut acc = [_mm512_setzero_ps(); 4];
+            let mut t = 0;
+            while t < taps {
+                let u = t / 2;
+                let lo = load(&tmp[4 * (i0 + 2 * u)..][..16].as_chunks::<16>().0[0]);
+                let hi = load(&tmp[4 * (i0 + 2 * u + 4)..][..16].as_chunks::<16>().0[0]);
+                let v = _mm512_permutex2var_ps(lo, even, hi);
+                acc[t % 4] = _mm512_fmadd_ps(w[t], v, acc[t % 4]);
+                if t + 1 < taps {
+                    let v = _mm512_permutex2var_ps(lo, odd, hi);
+                    acc[(t + 1) % 4] = _mm512_fmadd_ps(w[t + 1], v, acc[(t + 1) % 4]);
+                }
+                t += 2;
+            }
+            let s = _mm512_add_ps(_mm512_add_ps(acc[0], acc[1]), _mm512_add_ps(acc[2], acc[3]));
+            store(&mut dst[4 * x..][..16].as_chunks_mut::<16>().0[0], s);
+            x += 4;
+        }
+        (p.x0, x)
     }
 
     #[inline]
@@ -213,10 +335,16 @@ pub(crate) mod x86 {
         wx: &AxisWeights,
         runs: &[Option<u32>],
         ex: &Expanded,
+        xs: std::ops::Range<usize>,
     ) {
         let n = wx.taps * CH;
         let blocks = ex.pad / 16;
-        for (x, d) in dst.chunks_exact_mut(CH).enumerate() {
+        let first = xs.start;
+        for (x, d) in dst[CH * xs.start..CH * xs.end]
+            .chunks_exact_mut(CH)
+            .enumerate()
+            .map(|(i, d)| (first + i, d))
+        {
             let Some(i0) = runs[x] else {
                 texel_by_index(tmp, d, wx, x, CH);
                 continue;

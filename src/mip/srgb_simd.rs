@@ -65,13 +65,62 @@ pub fn row_rgba8(r0: &[u8], r1: &[u8], dst: &mut [u8], t: &FixedSrgb, avx512: bo
         assert!(supported(), "AVX-512 kernel requested on a CPU without it");
         #[allow(unsafe_code)]
         // SAFETY: the assert above (`supported()`) confirmed AVX-512 F, BW,
-        // VBMI and VNNI, the features `x86::row` is compiled for. The
+        // VBMI and VNNI, the features `x86::row_with` is compiled for. The
         // kernel reads and writes only through slices (64-byte arrays).
-        return unsafe { x86::row(r0, r1, dst, t, x86::tables(t)) };
+        return unsafe { x86::row_with(r0, r1, dst, None, t, x86::tables(t)) };
     }
     let _ = avx512;
     row_u8_srgb_n::<4, 3>(r0, r1, dst, t);
     false
+}
+
+/// [`row_rgba8`] with the AVX-512 kernel (the CPU must have it: see
+/// [`available`]), also writing each output texel unrounded in linear f32
+/// to `lin` (`dst.len()` floats): colour `s · 2^-26` of the kernel's sum,
+/// alpha the exact average of the four codes over 255. The fused first
+/// level of the box chain that rounds once (`mip/stream.rs`): level 0's
+/// codes are read once, and no f32 copy of level 0 is made. Returns the
+/// constant-alpha report of [`row_rgba8`] (always known here).
+pub fn row_rgba8_linear(
+    r0: &[u8],
+    r1: &[u8],
+    dst: &mut [u8],
+    lin: &mut [f32],
+    t: &FixedSrgb,
+) -> bool {
+    assert!(lin.len() == dst.len(), "one float per output value");
+    #[cfg(target_arch = "x86_64")]
+    {
+        assert!(supported(), "AVX-512 kernel requested on a CPU without it");
+        #[allow(unsafe_code)]
+        // SAFETY: the assert above (`supported()`) confirmed AVX-512 F, BW,
+        // VBMI and VNNI, the features `x86::row_with` is compiled for. The
+        // kernel reads and writes only through slices.
+        return unsafe { x86::row_with(r0, r1, dst, Some(lin), t, x86::tables(t)) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = (r0, r1, dst, lin, t);
+        unreachable!("AVX-512 kernel requested on a CPU without it")
+    }
+}
+
+/// The scalar unrounded values of [`row_rgba8_linear`] for output values
+/// from `from` on (the tail of a row), the kernel's own: the same sums
+/// (code 255 counting 2^24 − 1, see `x86::sum4`), the same conversions.
+fn linear_tail(r0: &[u8], r1: &[u8], lin: &mut [f32], from: usize, t: &FixedSrgb) {
+    let dec = t.dec();
+    let d = |c: u8| dec[c as usize] - u32::from(c == 255);
+    let unit = 1.0 / (1u64 << 26) as f32;
+    for (x, o) in lin.chunks_exact_mut(4).enumerate().skip(from / 4) {
+        let (p, q) = (8 * x, 8 * x + 4);
+        for c in 0..3 {
+            let s = d(r0[p + c]) + d(r0[q + c]) + d(r1[p + c]) + d(r1[q + c]);
+            o[c] = s as f32 * unit;
+        }
+        let a = r0[p + 3] as u32 + r0[q + 3] as u32 + r1[p + 3] as u32 + r1[q + 3] as u32;
+        o[3] = a as f32 / 1020.0;
+    }
 }
 
 /// Offset, in 1/65536 of a code, added before rounding down; lanes whose
@@ -108,7 +157,7 @@ mod x86 {
     use std::arch::x86_64::*;
     use std::sync::OnceLock;
 
-    use super::{AMBIGUITY, FixedSrgb, LINEAR_BELOW, POLY, SHORT_FROM, row_u8_srgb_n};
+    use super::{AMBIGUITY, FixedSrgb, LINEAR_BELOW, POLY, SHORT_FROM, linear_tail, row_u8_srgb_n};
 
     /// Byte planes of the decode table and the per-octave scales.
     pub struct Tables {
@@ -414,11 +463,67 @@ mod x86 {
         ]
     }
 
-    /// The kernel behind [`super::row_rgba8`]: blocks of 16 output texels,
-    /// then the scalar kernel for the rest of the row.
+    /// Index of the four RGBA output registers of a block of unrounded
+    /// values: lane `i` of register `j` is texel `4j + i / 4`, channel
+    /// `i % 4`; colour value `v = 3·texel + channel` is lane `v mod 16` of
+    /// colour register `v / 16`, and register `j` reads the pair
+    /// (`j / 2`, `j / 2 + 1`) of colour registers (bit 4 picks the second).
+    /// Alpha lanes hold the texel's index in the alpha register.
+    const fn interleave(j: usize) -> [u32; 16] {
+        let mut idx = [0u32; 16];
+        let mut i = 0;
+        while i < 16 {
+            let (texel, channel) = (4 * j + i / 4, i % 4);
+            idx[i] = if channel < 3 {
+                let v = 3 * texel + channel;
+                ((v / 16 - j / 2) * 16 + v % 16) as u32
+            } else {
+                texel as u32
+            };
+            i += 1;
+        }
+        idx
+    }
+
+    const INTERLEAVE: [[u32; 16]; 4] = [interleave(0), interleave(1), interleave(2), interleave(3)];
+
+    /// The 64 unrounded values of one block into `out` (see
+    /// [`super::row_rgba8_linear`]) from the sums of [`sums`].
+    #[inline]
     #[target_feature(enable = "avx512f,avx512bw,avx512vbmi,avx512vnni")]
-    pub fn row(r0: &[u8], r1: &[u8], dst: &mut [u8], t: &FixedSrgb, tab: &Tables) -> bool {
+    fn unrounded(s: [__m512i; 4], idx: &[__m512i; 4], out: &mut [f32; 64]) {
+        let unit = _mm512_set1_ps(1.0 / (1u64 << 26) as f32);
+        let c = [0, 1, 2].map(|r| _mm512_mul_ps(_mm512_cvtepi32_ps(s[r]), unit));
+        // 64·Σa + 128 back to Σa, over 4·255.
+        let sum_a = _mm512_sub_epi32(_mm512_srli_epi32::<6>(s[3]), _mm512_set1_epi32(2));
+        let a = _mm512_div_ps(_mm512_cvtepi32_ps(sum_a), _mm512_set1_ps(1020.0));
+        for (j, o) in out.as_chunks_mut::<16>().0.iter_mut().enumerate() {
+            let pair = j / 2;
+            let v = _mm512_permutex2var_ps(c[pair], idx[j], c[pair + 1]);
+            let v = _mm512_mask_permutexvar_ps(v, 0x8888, idx[j], a);
+            #[allow(unsafe_code)]
+            // SAFETY: AVX-512 F is enabled (callers checked it); `o` is 16
+            // writable floats, one unaligned store.
+            unsafe {
+                _mm512_storeu_ps(o.as_mut_ptr(), v)
+            };
+        }
+    }
+
+    /// The kernel behind [`super::row_rgba8`] and (with `lin`)
+    /// [`super::row_rgba8_linear`]: blocks of 16 output texels, then the
+    /// scalar kernel for the rest of the row.
+    #[target_feature(enable = "avx512f,avx512bw,avx512vbmi,avx512vnni")]
+    pub fn row_with(
+        r0: &[u8],
+        r1: &[u8],
+        dst: &mut [u8],
+        mut lin: Option<&mut [f32]>,
+        t: &FixedSrgb,
+        tab: &Tables,
+    ) -> bool {
         let k = consts(tab);
+        let idx = INTERLEAVE.map(|i| load(bytemuck::cast_ref(&i)));
         let g = Gather::new(r0[3]);
         let pack = load(&PACK);
         let mut diff = _mm512_setzero_si512();
@@ -440,6 +545,9 @@ mod x86 {
         }
         for (i, d) in d_blocks[..n].iter_mut().enumerate() {
             let [s0, s1, s2, na] = next;
+            if let Some(l) = lin.as_deref_mut() {
+                unrounded(next, &idx, &mut l.as_chunks_mut::<64>().0[i]);
+            }
             if i + 1 < n {
                 let (a, b) = pair(i + 1);
                 next = sums(&k, &g, a, b, &mut diff);
@@ -465,6 +573,9 @@ mod x86 {
         if done < dst.len() {
             let (t0, t1) = (&r0[2 * done..], &r1[2 * done..]);
             row_u8_srgb_n::<4, 3>(t0, t1, &mut dst[done..], t);
+            if let Some(l) = lin {
+                linear_tail(r0, r1, l, done, t);
+            }
             constant &= t0
                 .chunks_exact(4)
                 .chain(t1.chunks_exact(4))
@@ -526,6 +637,17 @@ mod tests {
         row_u8_srgb_n::<4, 3>(r0, r1, &mut want, t);
         let mut got = vec![0xA5u8; r0.len() / 2];
         let constant = row_rgba8(r0, r1, &mut got, t, true);
+        // The fused variant: the same codes and report, and unrounded
+        // values equal to the scalar sums' (blocks and tail alike).
+        let mut got2 = vec![0x5Au8; r0.len() / 2];
+        let mut lin = vec![f32::NAN; r0.len() / 2];
+        let constant2 = super::row_rgba8_linear(r0, r1, &mut got2, &mut lin, t);
+        assert!(got2 == got && constant2 == constant, "{what}: fused codes");
+        let mut want_lin = vec![0f32; lin.len()];
+        super::linear_tail(r0, r1, &mut want_lin, 0, t);
+        if let Some(i) = (0..lin.len()).find(|&i| lin[i].to_bits() != want_lin[i].to_bits()) {
+            panic!("{what}: value {i}: {} (scalar {})", lin[i], want_lin[i]);
+        }
         if let Some(i) = (0..want.len()).find(|&i| got[i] != want[i]) {
             let (x, c) = (i / 4, i % 4);
             let codes = [

@@ -16,8 +16,8 @@
 use rayon::prelude::*;
 
 use super::fast::box_row_f32;
-use super::{MipFilter, MipOptions};
-use crate::texel::{AlphaMode, Format, Texels};
+use super::{MipFilter, MipOptions, srgb_simd};
+use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels, TexelsMut};
 use crate::texture::Texture;
 
 /// Most levels made per band (bands of up to 2^4 = 16 level-0 rows: a
@@ -73,6 +73,46 @@ pub(crate) fn reduce_band(
     all_finite
 }
 
+/// Level 1 of a band of RGBA8 sRGB level 0 (`band`: rows of `w` texels),
+/// stored as `codes` and unrounded in linear f32 as `next`, by the
+/// AVX-512 sRGB box kernel ([`srgb_simd::row_rgba8_linear`]): level 0 is
+/// neither decoded to f32 nor written anywhere. Row pairs of straight
+/// alpha whose alphas differ take the decode-and-reduce path instead (the
+/// kernel's sums are unweighted).
+fn fused_level1(
+    band: &[u8],
+    w: usize,
+    fmt: Format,
+    straight: Option<usize>,
+    next: &mut Vec<f32>,
+    codes: &mut [u8],
+) {
+    let (row, nrow) = (4 * w, 2 * w);
+    let rows = band.len() / row.max(1);
+    next.resize(nrow * (rows / 2), 0.0);
+    let t = super::fast::fixed_tables();
+    let mut scratch = Vec::new();
+    for (r, (d, lin)) in codes
+        .chunks_exact_mut(nrow)
+        .zip(next.chunks_exact_mut(nrow))
+        .enumerate()
+    {
+        let (r0, r1) = (
+            &band[2 * r * row..][..row],
+            &band[(2 * r + 1) * row..][..row],
+        );
+        let constant = srgb_simd::row_rgba8_linear(r0, r1, d, lin, t);
+        if straight.is_some() && !constant {
+            scratch.resize(2 * row, 0.0);
+            let (f0, f1) = scratch.split_at_mut(row);
+            crate::texel::decode_u8(&fmt, r0, f0);
+            crate::texel::decode_u8(&fmt, r1, f1);
+            box_row_f32(f0, f1, lin, 4, straight);
+            crate::texel::encode_u8(&fmt, lin, d);
+        }
+    }
+}
+
 thread_local! {
     /// A band of one level and of the next, in linear f32.
     static SCRATCH: std::cell::RefCell<(Vec<f32>, Vec<f32>)> =
@@ -124,6 +164,12 @@ pub fn box_levels(base: &Texture, m: usize, stored: Format) -> Levels {
         _ => None,
     };
     let band_len = rows * w * ch;
+    // RGBA8 sRGB stored as it came: level 1 straight from the codes.
+    let fused = fmt.channel_type == ChannelType::U8
+        && fmt.color_space == ColorSpace::Srgb
+        && ch == 4
+        && stored == fmt
+        && srgb_simd::available();
     per_band
         .into_par_iter()
         .zip(last.par_chunks_mut(per_last))
@@ -135,24 +181,43 @@ pub fn box_levels(base: &Texture, m: usize, stored: Format) -> Levels {
                 let reduce = |prev: &[f32], lw: usize, lr: usize, next: &mut Vec<f32>| {
                     reduce_band(prev, lw, lr, ch, straight, next)
                 };
-                // Level 1 from level 0's band, decoded (or read in place).
-                let level1_finite = match in_place {
-                    Some(v) => reduce(&v[b * band_len..][..band_len], w, rows, next),
-                    None => {
-                        cur.resize(band_len, 0.0);
-                        crate::texel::decode_range_to_linear(&fmt, texels, b * band_len, cur);
-                        reduce(cur, w, rows, next)
+                let mut outs = outs.into_iter();
+                // Level 1 from level 0's band: fused from the codes, or
+                // decoded (or read in place), reduced and encoded.
+                let level1_finite = match (in_place, fused, texels, outs.next()) {
+                    (None, true, Texels::U8(v), Some(TexelsMut::U8(codes))) => {
+                        let band = &v[b * band_len..][..band_len];
+                        fused_level1(band, w, fmt, straight, next, codes);
+                        true
+                    }
+                    (_, _, _, out) => {
+                        let ok = match in_place {
+                            Some(v) => reduce(&v[b * band_len..][..band_len], w, rows, next),
+                            None => {
+                                cur.resize(band_len, 0.0);
+                                crate::texel::decode_range_to_linear(
+                                    &fmt,
+                                    texels,
+                                    b * band_len,
+                                    cur,
+                                );
+                                reduce(cur, w, rows, next)
+                            }
+                        };
+                        if let Some(out) = out {
+                            crate::texel::encode_into(&stored, next, out);
+                        }
+                        ok
                     }
                 };
                 if !level1_finite {
                     finite.store(false, Ordering::Relaxed);
                 }
+                std::mem::swap(cur, next);
                 let (mut lw, mut lr) = (w / 2, rows / 2);
-                for (k, out) in outs.into_iter().enumerate() {
-                    if k > 0 {
-                        reduce(cur, lw, lr, next);
-                        (lw, lr) = (lw / 2, lr / 2);
-                    }
+                for out in outs {
+                    reduce(cur, lw, lr, next);
+                    (lw, lr) = (lw / 2, lr / 2);
                     crate::texel::encode_into(&stored, next, out);
                     std::mem::swap(cur, next);
                 }

@@ -6,6 +6,7 @@
 //! encoded back with round-to-nearest. The conversions here are the single
 //! home of those rules; fast paths elsewhere are tested against them.
 
+mod codec8;
 pub mod srgb;
 
 use std::fmt;
@@ -492,6 +493,10 @@ fn par_zip<A: Sync, B: Send>(
 /// per value, the table (sRGB or `c / 255`) chosen per channel once, not
 /// per value.
 pub fn decode_u8(format: &Format, i: &[u8], o: &mut [f32]) {
+    let (ch, cc) = (format.channels as usize, srgb_channels(format));
+    if i.len() >= 64 && codec8::decode(i, o, ch, cc) {
+        return;
+    }
     let t = decode8_tables(format);
     match format.channels {
         1 => decode_u8_n::<1>(&t, i, o),
@@ -499,6 +504,14 @@ pub fn decode_u8(format: &Format, i: &[u8], o: &mut [f32]) {
         3 => decode_u8_n::<3>(&t, i, o),
         _ => decode_u8_n::<4>(&t, i, o),
     }
+}
+
+/// How many leading channels of `format` are sRGB-encoded (the colour
+/// channels of an sRGB format, none of a linear one).
+fn srgb_channels(format: &Format) -> usize {
+    (0..format.channels as usize)
+        .take_while(|&c| format.is_srgb_channel(c))
+        .count()
 }
 
 /// The decode table of each channel of an 8-bit `format`.
@@ -541,6 +554,10 @@ pub fn decode_u16(format: &Format, i: &[u16], o: &mut [f32]) {
 /// Encode linear f32 (whole texels) to 8-bit values, rounding to nearest
 /// (sRGB channels by the exact curve's decision thresholds).
 pub fn encode_u8(format: &Format, i: &[f32], o: &mut [u8]) {
+    let (ch, cc) = (format.channels as usize, srgb_channels(format));
+    if i.len() >= 64 && codec8::encode(i, o, ch, cc) {
+        return;
+    }
     match (format.channels, format.color_space, format.has_alpha()) {
         (1, ColorSpace::Srgb, _) => encode_u8_n::<1, 1>(i, o),
         (2, ColorSpace::Srgb, true) => encode_u8_n::<2, 1>(i, o),
