@@ -403,7 +403,34 @@ fn reduced_levels(
             made.last,
         )?);
     }
-    for (k, &(w, h)) in sizes.iter().enumerate().skip(m + 1) {
+    // Levels 1 and 2 at once from 8- and 16-bit level 0 (the separable
+    // filters), level 1 never whole in f32 (sep_fast::try_reduce_two).
+    let fuse = m == 0
+        && sizes.len() > 2
+        && separate
+        && options.fast_paths
+        && options.filter != MipFilter::Box
+        && options.alpha_coverage.is_none();
+    let two = fuse
+        .then(|| sep_fast::try_reduce_two(base, sizes[1], sizes[2], options, stored))
+        .flatten();
+    let mut from = m + 1;
+    if let Some(two) = two {
+        for (k, t) in [(1, two.stored1), (2, two.stored2)] {
+            let (w, h) = sizes[k];
+            levels.push(Texture::from_texels(w, h, stored, t)?);
+            done(k, w as u64 * h as u64);
+        }
+        let (w2, h2) = sizes[2];
+        work = Some(Texture::from_f32(
+            w2,
+            h2,
+            working_format(stored),
+            two.linear2,
+        )?);
+        from = 3;
+    }
+    for (k, &(w, h)) in sizes.iter().enumerate().skip(from) {
         let prev = match (&work, levels.last()) {
             (Some(t), _) => t,
             (None, Some(t)) => t,

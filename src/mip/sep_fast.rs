@@ -24,7 +24,7 @@ use rayon::prelude::*;
 
 use super::MipOptions;
 use super::fast::ReducedLinear;
-use super::separable::{Reducer, one_alpha};
+use super::separable::{Reducer, one_alpha, one_alpha_u8};
 use crate::texel::{ChannelType, ColorSpace, Format, Texels, TexelsMut};
 use crate::texture::Texture;
 
@@ -89,6 +89,178 @@ pub(crate) fn try_reduce_linear(
         stored,
         finite: finite.into_inner(),
     })
+}
+
+/// Levels 1 and 2 of a chain made together by [`try_reduce_two`].
+pub(crate) struct TwoLevels {
+    /// Level 1 in the stored format (it is never whole in f32).
+    pub stored1: Texels,
+    /// Level 2 in linear f32, unrounded, and in the stored format.
+    pub linear2: Vec<f32>,
+    pub stored2: Texels,
+}
+
+/// Levels 1 (`s1`) and 2 (`s2`) of an 8- or 16-bit `src` at once, level
+/// 1 only in the stored format `encode`; `None` when the source is not
+/// 8- or 16-bit or `encode` has other channels or is f32.
+///
+/// [`try_reduce_linear`] twice would write level 1 whole in linear f32
+/// and read it back: for a 4096² RGBA8 level 0 that is 64 MiB of fresh
+/// pages, a fifth of the Kaiser chain's time on Zen 4. Here each band of
+/// level-2 rows makes the level-1 rows its taps read into a ring of
+/// `taps + 1` rows, from level-0 rows decoded into a ring of their own.
+/// A band owns the level-1 rows in proportion to its level-2 rows and
+/// encodes each of them once (those no level-2 tap reads are made at the
+/// end of the band); rows near a band's edge are also made by the
+/// neighbour (about `taps / (2 · band)` more level-1 rows). Every row is
+/// made by the same code from the same rows as on the two-pass path, so
+/// the values are the same bit for bit. (8- and 16-bit sources are
+/// finite, so no finite flag comes back.)
+pub(crate) fn try_reduce_two(
+    src: &Texture,
+    s1: (u32, u32),
+    s2: (u32, u32),
+    options: &MipOptions,
+    encode: Format,
+) -> Option<TwoLevels> {
+    let fmt = src.format();
+    if !matches!(src.texels(), Texels::U8(_) | Texels::U16(_))
+        || encode.channels != fmt.channels
+        || encode.channel_type == ChannelType::F32
+    {
+        return None;
+    }
+    let r1 = Reducer::new(fmt, src.width(), src.height(), s1.0, s1.1, options).fast();
+    let r2 = Reducer::new(fmt, s1.0, s1.1, s2.0, s2.1, options).fast();
+    let ch = r1.ch;
+    let (row1, row2) = (s1.0 as usize * ch, s2.0 as usize * ch);
+    let (h1, h2) = (s1.1 as usize, s2.1 as usize);
+    let mut stored1 = Texels::zeroed(encode.channel_type, row1 * h1);
+    let mut linear2: Vec<f32> = crate::mem::zeroed(row2 * h2);
+    let mut stored2 = Texels::zeroed(encode.channel_type, row2 * h2);
+    let threads = rayon::current_num_threads().max(1);
+    // Longer bands than one level's: fewer level-1 rows made twice.
+    let band = h2.div_ceil(4 * threads).clamp(1, 2 * MAX_BAND);
+    let bands = h2.div_ceil(band);
+    // Band b owns level-1 rows own(b)..own(b + 1).
+    let own = |b: usize| if b >= bands { h1 } else { b * band * h1 / h2 };
+    let mut rows1 = stored1.chunks_mut(row1.max(1)).into_iter();
+    let owned: Vec<(usize, Vec<Option<TexelsMut<'_>>>)> = (0..bands)
+        .map(|b| {
+            let rows = rows1.by_ref().take(own(b + 1) - own(b)).map(Some);
+            (own(b), rows.collect())
+        })
+        .collect();
+    let source = Source {
+        fmt,
+        texels: src.texels(),
+        in_place: None,
+        n: r1.sw * ch,
+    };
+    linear2
+        .par_chunks_mut((row2 * band).max(1))
+        .zip(stored2.chunks_mut((row2 * band).max(1)))
+        .zip(owned)
+        .enumerate()
+        .for_each(|(b, ((out, coded), (first, owned)))| {
+            let mut ring = Level1Ring {
+                r1: &r1,
+                source: &source,
+                encode: &encode,
+                below: RowCache::new(r1.wy.taps + 1, source.n),
+                rows: RowCache::new(r2.wy.taps + 1, row1),
+                first,
+                owned,
+                made: 0,
+                tmp: vec![0f32; source.n],
+                scratch: Vec::new(),
+            };
+            let (mut tmp, mut scratch) = (vec![0f32; row1], Vec::new());
+            let mut coded_rows = split_rows(coded, row2);
+            let y0 = b * band;
+            for (i, dst) in out.chunks_exact_mut(row2.max(1)).enumerate() {
+                let y = y0 + i;
+                for (j, _) in r2.wy.of(y) {
+                    ring.ensure(j, y);
+                }
+                let rows = &ring.rows;
+                let row_of = |j: u32| rows.held(j);
+                let alpha_of = |j: u32, _: usize| rows.alpha(j);
+                r2.row(y, &row_of, &alpha_of, &mut tmp, &mut scratch, dst);
+                if let Some(c) = coded_rows.get_mut(i).and_then(Option::take) {
+                    crate::texel::encode_into(&encode, dst, c);
+                }
+            }
+            // Owned level-1 rows no level-2 row of the band read.
+            let mut clock = y0 + out.len() / row2.max(1);
+            for k in 0..ring.owned.len() {
+                if ring.owned[k].is_some() {
+                    ring.ensure((first + k) as u32, clock);
+                    clock += 1;
+                }
+            }
+        });
+    Some(TwoLevels {
+        stored1,
+        linear2,
+        stored2,
+    })
+}
+
+/// The level-1 rows one band of [`try_reduce_two`] reads, made from the
+/// level-0 rows below them on demand.
+struct Level1Ring<'a, 's> {
+    r1: &'a Reducer,
+    source: &'a Source<'s>,
+    encode: &'a Format,
+    /// Level-0 rows, decoded.
+    below: RowCache,
+    /// Level-1 rows, made.
+    rows: RowCache,
+    /// The first level-1 row the band owns, and the owned rows' stored
+    /// values not yet written.
+    first: usize,
+    owned: Vec<Option<TexelsMut<'a>>>,
+    /// Level-1 rows made so far (the clock of `below`).
+    made: usize,
+    tmp: Vec<f32>,
+    scratch: Vec<f32>,
+}
+
+impl Level1Ring<'_, '_> {
+    /// Make level-1 row `j` present for level-2 row (or clock) `y`,
+    /// writing its stored values if the band owns it.
+    fn ensure(&mut self, j: u32, y: usize) {
+        let Some(k) = self.rows.claim(j, y) else {
+            return;
+        };
+        for (i, _) in self.r1.wy.of(j as usize) {
+            self.below
+                .ensure(i, self.made, self.source, self.r1.straight);
+        }
+        self.made += 1;
+        let (below, source) = (&self.below, self.source);
+        let row_of = |i: u32| below.row(i, source);
+        let alpha_of = |i: u32, _: usize| below.alpha(i);
+        let dst = self.rows.slot_data(k);
+        self.r1.row(
+            j as usize,
+            &row_of,
+            &alpha_of,
+            &mut self.tmp,
+            &mut self.scratch,
+            dst,
+        );
+        let alpha = self.r1.straight.and_then(|a| one_alpha(dst, self.r1.ch, a));
+        if let Some(c) = (j as usize)
+            .checked_sub(self.first)
+            .and_then(|o| self.owned.get_mut(o))
+            .and_then(Option::take)
+        {
+            crate::texel::encode_into(self.encode, dst, c);
+        }
+        self.rows.slots[k] = (j, y + 1, alpha);
+    }
 }
 
 /// Where a band's source rows come from.
@@ -170,11 +342,13 @@ impl RowCache {
         self.slots.iter().position(|s| s.0 == j)
     }
 
-    /// Make source row `j` present for destination row `y`.
-    fn ensure(&mut self, j: u32, y: usize, source: &Source<'_>, straight: Option<usize>) {
+    /// Claim a slot for source row `j`, read by destination row `y`:
+    /// `None` when the row is present (now marked as read by `y`), else
+    /// the slot to fill (the least recently read one).
+    fn claim(&mut self, j: u32, y: usize) -> Option<usize> {
         if let Some(k) = self.slot(j) {
             self.slots[k].1 = y + 1;
-            return;
+            return None;
         }
         let k = self
             .slots
@@ -183,30 +357,53 @@ impl RowCache {
             .min_by_key(|(_, s)| s.1)
             .map_or(0, |(k, _)| k);
         debug_assert!(self.slots[k].1 <= y, "a row in use is never evicted");
+        Some(k)
+    }
+
+    /// The data of slot `k` (allocated on first use: a cache over a
+    /// level read in place never needs it).
+    fn slot_data(&mut self, k: usize) -> &mut [f32] {
+        if self.data.is_empty() {
+            self.data = vec![0f32; self.slots.len() * self.n];
+        }
+        &mut self.data[k * self.n..][..self.n]
+    }
+
+    /// Make source row `j` present for destination row `y`.
+    fn ensure(&mut self, j: u32, y: usize, source: &Source<'_>, straight: Option<usize>) {
+        let Some(k) = self.claim(j, y) else { return };
         let n = self.n;
         let start = j as usize * n;
         let row: &[f32] = match source.in_place {
             Some(v) => &v[start..][..n],
             None => {
-                if self.data.is_empty() {
-                    self.data = vec![0f32; self.slots.len() * n];
-                }
-                let d = &mut self.data[k * n..][..n];
+                let d = self.slot_data(k);
                 crate::texel::decode_range_to_linear(&source.fmt, source.texels, start, d);
                 d
             }
         };
-        let alpha = straight.and_then(|a| one_alpha(row, source.fmt.channels as usize, a));
+        let ch = source.fmt.channels as usize;
+        let alpha = straight.and_then(|a| match source.texels {
+            Texels::U8(codes) if source.in_place.is_none() => {
+                one_alpha_u8(&codes[start..][..n], ch, a).then(|| row[a].to_bits())
+            }
+            _ => one_alpha(row, ch, a),
+        });
         self.slots[k] = (j, y + 1, alpha);
+    }
+
+    /// Row `j` as held in this cache's own slots (present).
+    fn held(&self, j: u32) -> &[f32] {
+        let k = self.slot(j).unwrap_or_default();
+        &self.data[k * self.n..][..self.n]
     }
 
     /// Source row `j` (present: see [`RowCache::ensure`]).
     fn row<'s>(&'s self, j: u32, source: &Source<'s>) -> &'s [f32] {
         // Always present (see `ensure`); never a panic path.
-        let k = self.slot(j).unwrap_or_default();
         match source.in_place {
             Some(v) => &v[j as usize * self.n..][..self.n],
-            None => &self.data[k * self.n..][..self.n],
+            None => self.held(j),
         }
     }
 

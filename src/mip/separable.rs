@@ -334,6 +334,24 @@ pub(crate) fn one_alpha(row: &[f32], ch: usize, a: usize) -> Option<u32> {
     (diff == 0).then_some(first)
 }
 
+/// [`one_alpha`] of an 8-bit row before it is decoded: the decode of an
+/// alpha code is one float per code and no two codes share one, so the
+/// codes are all equal exactly when the decoded alphas are (a quarter of
+/// the bytes to read). True when every texel has the first texel's alpha.
+pub(crate) fn one_alpha_u8(row: &[u8], ch: usize, a: usize) -> bool {
+    debug_assert!(ch == 2 || ch == 4);
+    let first = row[a];
+    let mask: [u8; 64] = std::array::from_fn(|i| if i % ch == a { !0 } else { 0 });
+    let (words, rest) = row.as_chunks::<64>();
+    let mut acc = [0u8; 64];
+    for w in words {
+        for i in 0..64 {
+            acc[i] |= (w[i] ^ first) & mask[i];
+        }
+    }
+    acc.iter().fold(0, |x, y| x | y) | rest.chunks_exact(ch).fold(0, |x, t| x | (t[a] ^ first)) == 0
+}
+
 /// Vertical then horizontal pass of one destination row: with AVX2 and
 /// FMA when the CPU has them (detected once at run time; setting
 /// `PARVO_NO_AVX` turns it off for comparisons), else the portable code
@@ -537,6 +555,44 @@ mod tests {
     use super::*;
     use crate::mip::MipFilter;
     use crate::wrap::WrapMode;
+
+    /// The 8-bit "one alpha" test against the decoded one, on rows of
+    /// awkward lengths (tails of the 64-byte blocks) with one alpha code
+    /// changed at every position in turn, or none.
+    #[test]
+    fn one_alpha_u8_agrees_with_the_decoded_test() {
+        let mut s = 0x2545_F491u32;
+        for (ch, a) in [(2usize, 1usize), (4, 3), (4, 0), (2, 0)] {
+            for texels in [1usize, 7, 16, 33, 97] {
+                let mut row: Vec<u8> = (0..texels * ch)
+                    .map(|_| {
+                        s ^= s << 13;
+                        s ^= s >> 17;
+                        s ^= s << 5;
+                        s as u8
+                    })
+                    .collect();
+                let alpha = row[a];
+                for t in 0..texels {
+                    row[t * ch + a] = alpha;
+                }
+                for changed in (0..texels).map(Some).chain([None]) {
+                    let mut r = row.clone();
+                    if let Some(t) = changed {
+                        r[t * ch + a] = alpha.wrapping_add(1 + t as u8 % 200);
+                    }
+                    let decoded: Vec<f32> = r.iter().map(|&c| c as f32 / 255.0).collect();
+                    let want = one_alpha(&decoded, ch, a).is_some();
+                    assert_eq!(
+                        one_alpha_u8(&r, ch, a),
+                        want,
+                        "{ch} ch, {texels}, {changed:?}"
+                    );
+                    assert_eq!(want, changed.is_none_or(|t| t == 0 && texels == 1));
+                }
+            }
+        }
+    }
 
     /// The AVX2/FMA row kernel against the portable one: every channel
     /// count, widths with and without a remainder of the 32-value blocks,
