@@ -81,8 +81,10 @@ impl AddressOnly {
         self.trace_blocks(q, &mut Texels(sink));
     }
 
-    /// [`AddressOnly::trace`] of every query of `qs` in order (see
-    /// [`AddressOnly::trace_all`]).
+    /// [`AddressOnly::trace`] of every query of `qs` in order: on CPUs
+    /// with the sampler's AVX-512 paths the level plans and wrapped
+    /// coordinates of 8 queries at a time (the same texels, in the same
+    /// order).
     pub fn trace_slice<S: TexelSink>(&self, qs: &[Query], sink: &mut S) {
         self.trace_all(qs, &mut Texels(sink));
     }
