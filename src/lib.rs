@@ -92,6 +92,7 @@ pub mod sat;
 pub mod scene;
 pub mod setting;
 pub mod shade;
+mod simd;
 pub mod store;
 pub mod texel;
 pub mod texture;

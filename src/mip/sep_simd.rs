@@ -168,6 +168,7 @@ pub(crate) mod x86 {
 
     use super::{Expanded, Stride2, texel_by_index};
     use crate::mip::weights::AxisWeights;
+    use crate::simd::{load_ps as load, store_ps as store};
 
     #[target_feature(enable = "avx512f,avx512vl,avx512dq,fma")]
     pub(crate) fn filter_row(
@@ -253,28 +254,6 @@ pub(crate) mod x86 {
             x += 4;
         }
         (p.x0, x)
-    }
-
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn load(v: &[f32; 16]) -> __m512 {
-        #[allow(unsafe_code)]
-        // SAFETY: AVX-512 F is enabled (callers checked it); `v` is 16
-        // readable floats, one unaligned load.
-        unsafe {
-            _mm512_loadu_ps(v.as_ptr())
-        }
-    }
-
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn store(d: &mut [f32; 16], v: __m512) {
-        #[allow(unsafe_code)]
-        // SAFETY: AVX-512 F is enabled (callers checked it); `d` is 16
-        // writable floats, one unaligned store.
-        unsafe {
-            _mm512_storeu_ps(d.as_mut_ptr(), v)
-        }
     }
 
     /// The first `v.len()` (at most 16) lanes from `v`, the rest zero.

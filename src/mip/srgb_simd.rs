@@ -19,9 +19,10 @@
 //!   the sRGB encode in f32: the linear segment near black (exact there),
 //!   else `1.055·x^(5/12) − 0.055` with `x^(5/12)` as a per-octave scale
 //!   (one `vpermps` from the float exponent) times a degree-6 polynomial in
-//!   the mantissa. The code is rounded down in 1/65536 steps after adding
-//!   `AMBIGUITY` steps, so a result whose fraction is below `2·AMBIGUITY`
-//!   steps may be one too high: those lanes (1 in 2000 of all sums) are
+//!   the mantissa (the codec's `PowerSegment`, `texel/codec8.rs`). The
+//!   code is rounded down in 1/65536 steps after adding `AMBIGUITY` steps,
+//!   so a result whose fraction is below `2·AMBIGUITY` steps may be one
+//!   code too high: those lanes (1 in 2000 of all sums) are
 //!   redone with the scalar [`FixedSrgb::encode4`]. Every other lane is the
 //!   scalar code, which a unit test checks for every `s` in 0..=2^26.
 //! - Alpha is the rounded linear average `(a + b + c + d + 2) >> 2`, and the
@@ -123,26 +124,6 @@ fn linear_tail(r0: &[u8], r1: &[u8], lin: &mut [f32], from: usize, t: &FixedSrgb
     }
 }
 
-/// Offset, in 1/65536 of a code, added before rounding down; lanes whose
-/// result lies less than `2·AMBIGUITY` steps above a code boundary are
-/// redone exactly. It must exceed the f32 evaluation error (the
-/// polynomial's bound is about 7 steps; 4 already passes the exhaustive
-/// test, 16 leaves a margin and redoes 1 sum in 2000).
-const AMBIGUITY: u32 = 16;
-
-/// `m^(5/12)` for `m` in [1, 2): the degree-6 Chebyshev interpolant,
-/// expanded in powers of `m` (relative error 2.4e-7, 3.8e-7 evaluated in
-/// f32; at most 1e-4 of a code after scaling by 255·1.055).
-const POLY: [f32; 7] = [
-    0.351_870_06,
-    1.057_500_4,
-    -0.676_159_26,
-    0.379_771_56,
-    -0.139_750_14,
-    0.029_459_171,
-    -0.002_691_525_7,
-];
-
 /// The smallest sum (2^-26 units) that holds a code 255, as the kernel
 /// sums it (2^24 − 1, see `x86::sum4`).
 const SHORT_FROM: u32 = (1 << 24) - 1;
@@ -157,7 +138,8 @@ mod x86 {
     use std::arch::x86_64::*;
     use std::sync::OnceLock;
 
-    use super::{AMBIGUITY, FixedSrgb, LINEAR_BELOW, POLY, SHORT_FROM, linear_tail, row_u8_srgb_n};
+    use super::{FixedSrgb, LINEAR_BELOW, SHORT_FROM, linear_tail, row_u8_srgb_n};
+    use crate::texel::codec8::x86::PowerSegment;
 
     /// Byte planes of the decode table and the per-octave scales.
     pub struct Tables {
@@ -223,17 +205,13 @@ mod x86 {
     #[derive(Clone, Copy)]
     struct Consts {
         planes: [[__m512i; 4]; 3],
-        poly: [__m512; 7],
-        scale: __m512,
-        /// Constant term of the power segment, `65536·(0.5 − 255·0.055)`
-        /// plus the ambiguity offset.
-        pow_k: __m512,
+        /// The power segment (its scale in this kernel's units).
+        power: PowerSegment,
         /// The linear segment, `65536·255·12.92·s/2^26 + 65536·0.5`: no
         /// offset, as it is never flagged (see `encode`).
         lin_m: __m512,
         lin_k: __m512,
         split: __m512i,
-        ambiguous: __m512i,
         ones: __m512i,
         bit6: __m512i,
     }
@@ -246,25 +224,12 @@ mod x86 {
                 *r = load(part);
             }
         }
-        let off = 32768.0 + AMBIGUITY as f64;
-
         Consts {
             planes,
-            poly: [
-                _mm512_set1_ps(POLY[0]),
-                _mm512_set1_ps(POLY[1]),
-                _mm512_set1_ps(POLY[2]),
-                _mm512_set1_ps(POLY[3]),
-                _mm512_set1_ps(POLY[4]),
-                _mm512_set1_ps(POLY[5]),
-                _mm512_set1_ps(POLY[6]),
-            ],
-            scale: _mm512_castsi512_ps(load(bytemuck::cast_ref(&tab.scale))),
-            pow_k: _mm512_set1_ps((off - 65536.0 * 255.0 * 0.055) as f32),
+            power: PowerSegment::new(&tab.scale),
             lin_m: _mm512_set1_ps((65536.0 * 255.0 * 12.92 / (1u64 << 26) as f64) as f32),
             lin_k: _mm512_set1_ps(32768.0),
             split: _mm512_set1_epi32(LINEAR_BELOW as i32),
-            ambiguous: _mm512_set1_epi32((0xFFFF & !(2 * AMBIGUITY - 1)) as i32),
             ones: _mm512_set1_epi8(1),
             bit6: _mm512_set1_epi8(0x40),
         }
@@ -322,23 +287,12 @@ mod x86 {
     #[target_feature(enable = "avx512f,avx512bw,avx512vbmi,avx512vnni")]
     fn encode(k: &Consts, s: __m512i) -> (__m512i, __mmask16) {
         let f = _mm512_cvtepi32_ps(s);
-        let m = _mm512_getmant_ps::<_MM_MANT_NORM_1_2, _MM_MANT_SIGN_SRC>(f);
-        let c = &k.poly;
-        let m2 = _mm512_mul_ps(m, m);
-        let p01 = _mm512_fmadd_ps(c[1], m, c[0]);
-        let p23 = _mm512_fmadd_ps(c[3], m, c[2]);
-        let p45 = _mm512_fmadd_ps(c[5], m, c[4]);
-        let p456 = _mm512_fmadd_ps(c[6], m2, p45);
-        let p0123 = _mm512_fmadd_ps(p23, m2, p01);
-        let m4 = _mm512_mul_ps(m2, m2);
-        let p = _mm512_fmadd_ps(p456, m4, p0123);
-        let sc = _mm512_permutexvar_ps(_mm512_srli_epi32::<23>(_mm512_castps_si512(f)), k.scale);
-        let pow = _mm512_fmadd_ps(sc, p, k.pow_k);
+        let pow = k.power.eval(f);
         let lin = _mm512_fmadd_ps(f, k.lin_m, k.lin_k);
         let power = _mm512_cmpge_epi32_mask(s, k.split);
         let v = _mm512_mask_blend_ps(power, lin, pow);
         let n = _mm512_cvt_roundps_epi32::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(v);
-        (n, _mm512_mask_testn_epi32_mask(power, n, k.ambiguous))
+        (n, k.power.ambiguous(power, n))
     }
 
     /// 16 codes of `encode` for the exhaustive test: `(code, ambiguous)`.

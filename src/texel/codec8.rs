@@ -5,17 +5,17 @@
 //! the time of an 8-bit chain (issue 32: 40% of the sRGB box chain was
 //! `encode_u8`, another 24% `decode_u8`).
 //!
-//! - **Decode** is a table look-up: 16 codes widened to dwords, offset by
-//!   256 in the lanes of linear channels, one `vgatherdps` from a 512-entry
-//!   table (the sRGB table, then `k / 255`), the same floats the scalar
-//!   tables hold.
+//! - **Decode**, sRGB lanes: 16 codes widened to dwords and looked up in
+//!   the sRGB table held in 16 registers (eight two-register permutes and
+//!   three blends); linear lanes: `code · (1/255)`. The same floats the
+//!   scalar tables hold.
 //! - **Encode**, linear lanes: `v · 255 + 0.5`, clamped, truncated, as
 //!   [`super::unorm8`] does (NaN to 0; the two operations are not fused).
 //! - **Encode**, sRGB lanes: the curve in f32, in 1/65536 of a code: the
 //!   linear segment below 0.0031308, else `1.055·l^(5/12) − 0.055` with
 //!   `l^(5/12)` as a per-octave scale (one `vpermps` from the exponent) times
-//!   a degree-6 polynomial in the mantissa (the polynomial of
-//!   `mip/srgb_simd.rs`, which encodes fixed-point sums the same way). An
+//!   a degree-6 polynomial in the mantissa (`x86::PowerSegment`, which
+//!   `mip/srgb_simd.rs` shares to encode its fixed-point sums). An
 //!   offset of `AMBIGUITY` steps is added before rounding down; a lane
 //!   whose fraction is below `2·AMBIGUITY` steps may be one code too high
 //!   and is redone with the scalar [`super::srgb::encode_u8_with`] (about
@@ -26,12 +26,17 @@
 //! ([`crate::cpu::avx512_sample`], which `PARVO_NO_AVX` turns off);
 //! otherwise, and for the last `len mod 16` values, the scalar loops run.
 
-/// Offset in 1/65536 of a code added before rounding down; lanes less
-/// than `2·AMBIGUITY` steps above a code boundary are redone exactly. The
-/// f32 evaluation error is below 8 steps (the exhaustive test).
+/// Offset, in 1/65536 of a code, added before rounding down; lanes whose
+/// result lies less than `2·AMBIGUITY` steps above a code boundary are
+/// redone exactly. It must exceed the f32 evaluation error (the
+/// polynomial's bound is about 7 steps; 4 already passes the exhaustive
+/// tests of both users, 16 leaves a margin and redoes about 1 value in
+/// 2000).
 const AMBIGUITY: u32 = 16;
 
-/// `m^(5/12)` for `m` in [1, 2) (see `mip/srgb_simd.rs`).
+/// `m^(5/12)` for `m` in [1, 2): the degree-6 Chebyshev interpolant,
+/// expanded in powers of `m` (relative error 2.4e-7, 3.8e-7 evaluated in
+/// f32; at most 1e-4 of a code after scaling by 255·1.055).
 const POLY: [f32; 7] = [
     0.351_870_06,
     1.057_500_4,
@@ -121,6 +126,7 @@ pub(crate) mod x86 {
     use std::sync::OnceLock;
 
     use super::{AMBIGUITY, POLY, decode_scalar, encode_scalar, srgb_masks};
+    use crate::simd::{load_ps, store_ps};
 
     /// `65536 · 255 · 1.055 · 2^(5(E − 127)/12)` at index `E mod 16` for the
     /// biased float exponents E = 118..=127 of the power segment.
@@ -144,7 +150,7 @@ pub(crate) mod x86 {
     pub(crate) fn decode(i: &[u8], o: &mut [f32], ch: usize, cc: usize) {
         let masks = srgb_masks(ch, cc);
         let rows = crate::texel::srgb::tables().decode8.as_chunks::<16>().0;
-        let lut: [__m512; 16] = std::array::from_fn(|r| load(&rows[r]));
+        let lut: [__m512; 16] = std::array::from_fn(|r| load_ps(&rows[r]));
         let scale = _mm512_set1_ps(1.0 / 255.0);
         let n = i.len().min(o.len()) / 16 * 16;
         for (k, (src, dst)) in i[..n]
@@ -159,12 +165,7 @@ pub(crate) mod x86 {
             let srgb = lookup256(&lut, idx);
             let linear = _mm512_mul_ps(_mm512_cvtepi32_ps(idx), scale);
             let v = _mm512_mask_blend_ps(masks[(16 * k) % ch], linear, srgb);
-            #[allow(unsafe_code)]
-            // SAFETY: AVX-512 F is enabled; `dst` is 16 writable floats
-            // (one unaligned store).
-            unsafe {
-                _mm512_storeu_ps(dst.as_mut_ptr(), v)
-            };
+            store_ps(dst, v);
         }
         decode_scalar(&i[n..], &mut o[n..], n, ch, cc);
     }
@@ -187,22 +188,9 @@ pub(crate) mod x86 {
         _mm512_mask_blend_ps(b7, low, high)
     }
 
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn load(v: &[f32; 16]) -> __m512 {
-        #[allow(unsafe_code)]
-        // SAFETY: AVX-512 F is enabled (callers checked it); `v` is 16
-        // readable floats, one unaligned load.
-        unsafe {
-            _mm512_loadu_ps(v.as_ptr())
-        }
-    }
-
     /// The constants of [`encode16`], as registers.
     struct Consts {
-        poly: [__m512; 7],
-        scale: __m512,
-        pow_k: __m512,
+        power: PowerSegment,
         lin_m: __m512,
         lin_k: __m512,
         split: __m512,
@@ -210,16 +198,13 @@ pub(crate) mod x86 {
         one: __m512,
         c255: __m512,
         half: __m512,
-        ambiguous: __m512i,
     }
 
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn consts() -> Consts {
         let off = 32768.0 + AMBIGUITY as f64;
         Consts {
-            poly: POLY.map(|c| _mm512_set1_ps(c)),
-            scale: load(scales()),
-            pow_k: _mm512_set1_ps((off - 65536.0 * 255.0 * 0.055) as f32),
+            power: PowerSegment::new(scales()),
             lin_m: _mm512_set1_ps((65536.0 * 255.0 * 12.92) as f32),
             lin_k: _mm512_set1_ps(off as f32),
             split: _mm512_set1_ps(0.003_130_8),
@@ -227,7 +212,68 @@ pub(crate) mod x86 {
             one: _mm512_set1_ps(1.0),
             c255: _mm512_set1_ps(255.0),
             half: _mm512_set1_ps(0.5),
-            ambiguous: _mm512_set1_epi32((0xFFFF & !(2 * AMBIGUITY - 1)) as i32),
+        }
+    }
+
+    /// The power segment of the sRGB encode, `255·(1.055·x^(5/12) −
+    /// 0.055)`, in 1/65536 of a code, plus `32768 + AMBIGUITY` (a half
+    /// code to round, and the offset the [`ambiguous`](Self::ambiguous)
+    /// test needs), in f32: `x^(5/12)` is a per-octave scale (one
+    /// `vpermps` from the float exponent) times a degree-6 polynomial in
+    /// the mantissa. Shared by this codec (values in [0, 1]) and the sRGB
+    /// box kernel of `mip/srgb_simd.rs` (fixed-point sums), which differ
+    /// only in their scale tables.
+    #[derive(Clone, Copy)]
+    pub(crate) struct PowerSegment {
+        poly: [__m512; 7],
+        scale: __m512,
+        pow_k: __m512,
+        ambiguous: __m512i,
+    }
+
+    impl PowerSegment {
+        /// `scale[E mod 16]` is `65536 · 255 · 1.055 · X_E^(5/12)`, where
+        /// `X_E` is the value, in the caller's units, of the float whose
+        /// biased exponent is E and mantissa 1 (for every E the segment
+        /// meets).
+        #[target_feature(enable = "avx512f")]
+        pub(crate) fn new(scale: &[f32; 16]) -> PowerSegment {
+            let off = 32768.0 + AMBIGUITY as f64;
+            PowerSegment {
+                poly: POLY.map(|c| _mm512_set1_ps(c)),
+                scale: load_ps(scale),
+                pow_k: _mm512_set1_ps((off - 65536.0 * 255.0 * 0.055) as f32),
+                ambiguous: _mm512_set1_epi32((0xFFFF & !(2 * AMBIGUITY - 1)) as i32),
+            }
+        }
+
+        /// The segment at each (positive, in range) lane of `f`, not yet
+        /// rounded: round it down and shift right by 16 for the code.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub(crate) fn eval(&self, f: __m512) -> __m512 {
+            let m = _mm512_getmant_ps::<_MM_MANT_NORM_1_2, _MM_MANT_SIGN_SRC>(f);
+            let c = &self.poly;
+            let m2 = _mm512_mul_ps(m, m);
+            let p01 = _mm512_fmadd_ps(c[1], m, c[0]);
+            let p23 = _mm512_fmadd_ps(c[3], m, c[2]);
+            let p45 = _mm512_fmadd_ps(c[5], m, c[4]);
+            let p456 = _mm512_fmadd_ps(c[6], m2, p45);
+            let p0123 = _mm512_fmadd_ps(p23, m2, p01);
+            let m4 = _mm512_mul_ps(m2, m2);
+            let p = _mm512_fmadd_ps(p456, m4, p0123);
+            let sc =
+                _mm512_permutexvar_ps(_mm512_srli_epi32::<23>(_mm512_castps_si512(f)), self.scale);
+            _mm512_fmadd_ps(sc, p, self.pow_k)
+        }
+
+        /// The lanes of `mask` whose rounded-down [`eval`](Self::eval)
+        /// `n` lies less than `2·AMBIGUITY` steps above a code boundary:
+        /// their code may be one too high, and is to be redone exactly.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub(crate) fn ambiguous(&self, mask: __mmask16, n: __m512i) -> __mmask16 {
+            _mm512_mask_testn_epi32_mask(mask, n, self.ambiguous)
         }
     }
 
@@ -242,23 +288,12 @@ pub(crate) mod x86 {
         let lin_code = _mm512_cvttps_epi32(u);
         // sRGB lanes. `max` gives its second operand for NaN: NaN to 0.
         let l = _mm512_min_ps(_mm512_max_ps(v, k.zero), k.one);
-        let m = _mm512_getmant_ps::<_MM_MANT_NORM_1_2, _MM_MANT_SIGN_SRC>(l);
-        let c = &k.poly;
-        let m2 = _mm512_mul_ps(m, m);
-        let p01 = _mm512_fmadd_ps(c[1], m, c[0]);
-        let p23 = _mm512_fmadd_ps(c[3], m, c[2]);
-        let p45 = _mm512_fmadd_ps(c[5], m, c[4]);
-        let p456 = _mm512_fmadd_ps(c[6], m2, p45);
-        let p0123 = _mm512_fmadd_ps(p23, m2, p01);
-        let m4 = _mm512_mul_ps(m2, m2);
-        let p = _mm512_fmadd_ps(p456, m4, p0123);
-        let sc = _mm512_permutexvar_ps(_mm512_srli_epi32::<23>(_mm512_castps_si512(l)), k.scale);
-        let pow = _mm512_fmadd_ps(sc, p, k.pow_k);
+        let pow = k.power.eval(l);
         let lin = _mm512_fmadd_ps(l, k.lin_m, k.lin_k);
         let power = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(l, k.split);
         let x = _mm512_mask_blend_ps(power, lin, pow);
         let n = _mm512_cvt_roundps_epi32::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(x);
-        let ambiguous = _mm512_mask_testn_epi32_mask(srgb, n, k.ambiguous);
+        let ambiguous = k.power.ambiguous(srgb, n);
         let code = _mm512_mask_blend_epi32(srgb, lin_code, _mm512_srli_epi32::<16>(n));
         (code, ambiguous)
     }
@@ -276,7 +311,7 @@ pub(crate) mod x86 {
             .zip(o[..n].as_chunks_mut::<16>().0)
             .enumerate()
         {
-            let v = load(src);
+            let v = load_ps(src);
             let (code, ambiguous) = encode16(&k, v, masks[(16 * b) % ch]);
             *dst = bytemuck::cast(_mm512_cvtepi32_epi8(code));
             if ambiguous != 0 {
@@ -303,7 +338,7 @@ pub(crate) mod x86 {
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     pub(crate) fn encode16_srgb(v: &[f32; 16]) -> ([u8; 16], u16) {
         let k = consts();
-        let (code, amb) = encode16(&k, load(v), 0xFFFF);
+        let (code, amb) = encode16(&k, load_ps(v), 0xFFFF);
         (bytemuck::cast(_mm512_cvtepi32_epi8(code)), amb)
     }
 }

@@ -6,7 +6,7 @@
 //! encoded back with round-to-nearest. The conversions here are the single
 //! home of those rules; fast paths elsewhere are tested against them.
 
-mod codec8;
+pub(crate) mod codec8;
 pub mod srgb;
 
 use std::fmt;
