@@ -18,9 +18,11 @@
 //!   `mip/srgb_simd.rs` shares to encode its fixed-point sums). An
 //!   offset of `AMBIGUITY` steps is added before rounding down; a lane
 //!   whose fraction is below `2·AMBIGUITY` steps may be one code too high
-//!   and is redone with the scalar [`super::srgb::encode_u8_with`] (about
-//!   1 value in 2000). Every other lane is the scalar code: a unit test
-//!   checks every f32 in [0, 1].
+//!   (about 1 value in 2000 of random data, far more on smooth gradients,
+//!   where averages of neighbouring codes land next to a threshold): those
+//!   lanes are settled in registers against the scalar thresholds of their
+//!   codes (one more lookup, a compare and a masked subtract). Every lane
+//!   is the scalar code: a unit test checks every f32 in [0, 1].
 //!
 //! Used when the CPU has AVX-512 F, BW, DQ, VL and VBMI
 //! ([`crate::cpu::avx512_sample`], which `PARVO_NO_AVX` turns off);
@@ -162,9 +164,13 @@ pub(crate) mod x86 {
         {
             let bytes: __m128i = bytemuck::cast(*src);
             let idx = _mm512_cvtepu8_epi32(bytes);
-            let srgb = lookup256(&lut, idx);
             let linear = _mm512_mul_ps(_mm512_cvtepi32_ps(idx), scale);
-            let v = _mm512_mask_blend_ps(masks[(16 * k) % ch], linear, srgb);
+            // No sRGB channel (a linear image): no lookup.
+            let v = if cc == 0 {
+                linear
+            } else {
+                _mm512_mask_blend_ps(masks[(16 * k) % ch], linear, lookup256(&lut, idx))
+            };
             store_ps(dst, v);
         }
         decode_scalar(&i[n..], &mut o[n..], n, ch, cc);
@@ -277,15 +283,22 @@ pub(crate) mod x86 {
         }
     }
 
+    /// 16 values to linear codes: `(v · 255 + 0.5) as u8` (NaN and below
+    /// 0 to 0).
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    fn linear16(k: &Consts, v: __m512) -> __m512i {
+        let u = _mm512_add_ps(_mm512_mul_ps(v, k.c255), k.half);
+        let u = _mm512_min_ps(_mm512_max_ps(u, k.zero), k.c255);
+        _mm512_cvttps_epi32(u)
+    }
+
     /// 16 values to codes: sRGB in the lanes of `srgb`, linear elsewhere;
     /// and the mask of sRGB lanes that may be one code too high.
     #[inline]
     #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
     fn encode16(k: &Consts, v: __m512, srgb: __mmask16) -> (__m512i, __mmask16) {
-        // Linear lanes: (v · 255 + 0.5) as u8 (NaN and below 0 to 0).
-        let u = _mm512_add_ps(_mm512_mul_ps(v, k.c255), k.half);
-        let u = _mm512_min_ps(_mm512_max_ps(u, k.zero), k.c255);
-        let lin_code = _mm512_cvttps_epi32(u);
+        let lin_code = linear16(k, v);
         // sRGB lanes. `max` gives its second operand for NaN: NaN to 0.
         let l = _mm512_min_ps(_mm512_max_ps(v, k.zero), k.one);
         let pow = k.power.eval(l);
@@ -302,7 +315,7 @@ pub(crate) mod x86 {
     pub(crate) fn encode(i: &[f32], o: &mut [u8], ch: usize, cc: usize) {
         let k = consts();
         let masks = srgb_masks(ch, cc);
-        let t = crate::texel::srgb::tables();
+        let floors: [__m512; 16] = std::array::from_fn(|r| load_ps(&floors()[r]));
         let n = i.len().min(o.len()) / 16 * 16;
         for (b, (src, dst)) in i[..n]
             .as_chunks::<16>()
@@ -312,24 +325,46 @@ pub(crate) mod x86 {
             .enumerate()
         {
             let v = load_ps(src);
-            let (code, ambiguous) = encode16(&k, v, masks[(16 * b) % ch]);
-            *dst = bytemuck::cast(_mm512_cvtepi32_epi8(code));
-            if ambiguous != 0 {
-                redo(src, dst, ambiguous, t);
+            if cc == 0 {
+                // A linear image: no sRGB lane.
+                *dst = bytemuck::cast(_mm512_cvtepi32_epi8(linear16(&k, v)));
+                continue;
             }
+            let (mut code, ambiguous) = encode16(&k, v, masks[(16 * b) % ch]);
+            if ambiguous != 0 {
+                code = settle(&floors, v, code, ambiguous);
+            }
+            *dst = bytemuck::cast(_mm512_cvtepi32_epi8(code));
         }
         encode_scalar(&i[n..], &mut o[n..], n, ch, cc);
     }
 
-    /// The scalar sRGB code of the lanes in `mask`.
-    #[cold]
+    /// The smallest value of each code: `floors[c / 16][c % 16]` is the
+    /// scalar threshold between codes c − 1 and c (−∞ for code 0).
+    fn floors() -> &'static [[f32; 16]; 16] {
+        static T: OnceLock<[[f32; 16]; 16]> = OnceLock::new();
+        T.get_or_init(|| {
+            let thr = &crate::texel::srgb::tables().thresholds;
+            std::array::from_fn(|r| {
+                std::array::from_fn(|i| match 16 * r + i {
+                    0 => f32::NEG_INFINITY,
+                    c => thr[c - 1],
+                })
+            })
+        })
+    }
+
+    /// The lanes of `mask` (sRGB lanes whose `code` may be one too high)
+    /// settled exactly: one lower where the clamped value lies below the
+    /// code's scalar threshold, so every lane is the scalar code (the
+    /// scalar encode counts the thresholds at or below the value).
     #[inline(never)]
-    fn redo(src: &[f32; 16], dst: &mut [u8; 16], mut mask: u16, t: &crate::texel::srgb::Tables) {
-        while mask != 0 {
-            let l = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            dst[l] = crate::texel::srgb::encode_u8_with(t, src[l]);
-        }
+    #[target_feature(enable = "avx512f")]
+    fn settle(floors: &[__m512; 16], v: __m512, code: __m512i, mask: __mmask16) -> __m512i {
+        // The clamp of `encode16` (NaN to 0).
+        let l = _mm512_min_ps(_mm512_max_ps(v, _mm512_setzero_ps()), _mm512_set1_ps(1.0));
+        let low = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(mask, l, lookup256(floors, code));
+        _mm512_mask_sub_epi32(code, low, code, _mm512_set1_epi32(1))
     }
 
     /// [`encode16`] for the exhaustive test: every lane sRGB; the codes
@@ -418,12 +453,20 @@ mod tests {
             0.003_130_8,
             0.5,
         ];
+        // Values at and next to every sRGB threshold: the lanes the
+        // polynomial flags as ambiguous.
+        let thr = &crate::texel::srgb::tables().thresholds;
+        let near: Vec<f32> = thr[..255]
+            .iter()
+            .flat_map(|&t| [t.next_down(), t, t.next_up()])
+            .collect();
         for (ch, cc) in layouts() {
             for len in [0usize, 7, 16, 33, 4096 + 5] {
                 let i: Vec<f32> = (0..len)
-                    .map(|k| match k % 5 {
+                    .map(|k| match k % 6 {
                         0 => specials[(next() as usize) % specials.len()],
                         1 => f32::from_bits(next() % 0x3F80_0001),
+                        2 => near[(next() as usize) % near.len()],
                         _ => (next() >> 8) as f32 / (1u32 << 24) as f32 * 1.1 - 0.05,
                     })
                     .collect();
@@ -453,6 +496,21 @@ mod tests {
             // SAFETY: `can_test()` confirmed the features `encode16_srgb`
             // needs.
             let (codes, amb) = unsafe { super::x86::encode16_srgb(&v) };
+            if amb != 0 {
+                // The whole encode settles the flagged lanes exactly.
+                let mut out = [0u8; 16];
+                assert!(super::encode(&v, &mut out, 1, 1));
+                for k in 0..16 {
+                    let want = crate::texel::srgb::encode_u8_with(t, v[k]);
+                    assert_eq!(
+                        out[k],
+                        want,
+                        "l = {:e} ({:#x}), settled",
+                        v[k],
+                        v[k].to_bits()
+                    );
+                }
+            }
             for k in 0..16 {
                 if amb >> k & 1 == 1 {
                     flagged += 1;
