@@ -366,11 +366,9 @@ impl SceneSetup<'_> {
     pub fn record(&self) -> Trace {
         let layouts = [self.layout];
         let tracer = self.tracer(&layouts, Issue::Stream);
-        let units = tracer.units();
-        let chunks: Vec<Chunk> = units
-            .par_chunks(CHUNK)
-            .map(|c| tracer.produce(c, None, None))
-            .collect();
+        let list = tracer.unit_list();
+        let n = tracer.unit_count(list.as_deref());
+        let chunks = tracer.produce_range(list.as_deref(), (0, n as usize), None, None);
         let n = chunks.iter().map(|c| c.accesses[0].len()).sum();
         let mut accesses = Vec::with_capacity(n);
         for c in &chunks {
@@ -522,12 +520,60 @@ struct Tracer<'a> {
 }
 
 impl Tracer<'_> {
-    /// The pixels, or quads, in raster order.
-    fn units(&self) -> Vec<(u32, u32)> {
+    /// The pixels, or quads, in raster order, when the order needs the
+    /// list; `None` when each chunk works out its own
+    /// ([`Tracer::units_in`]): the list of a 1080p frame is 16 MiB that
+    /// one thread would fill, every page faulted in, before any sampling.
+    fn unit_list(&self) -> Option<Vec<(u32, u32)>> {
         match self.issue {
-            Issue::Quads => self.order.quads(self.frame),
-            _ => self.order.pixel_list(self.frame),
+            Issue::Quads => Some(self.order.quads(self.frame)),
+            _ if self.order.has_ranges() => None,
+            _ => Some(self.order.pixel_list(self.frame)),
         }
+    }
+
+    /// How many units [`Tracer::unit_list`] has (or would have).
+    fn unit_count(&self, list: Option<&[(u32, u32)]>) -> u64 {
+        list.map_or(self.frame.pixels(), |l| l.len() as u64)
+    }
+
+    /// Units `start .. start + len`: a slice of `list`, or worked out
+    /// into `buf` when there is none.
+    fn units_in<'u>(
+        &self,
+        list: Option<&'u [(u32, u32)]>,
+        start: u64,
+        len: usize,
+        buf: &'u mut Vec<(u32, u32)>,
+    ) -> &'u [(u32, u32)] {
+        match list {
+            Some(l) => &l[start as usize..start as usize + len],
+            None => {
+                buf.clear();
+                self.order.pixel_range(self.frame, start, len, buf);
+                buf
+            }
+        }
+    }
+
+    /// The chunks of `len` units from `start`, sampled on the pool, in
+    /// order.
+    fn produce_range(
+        &self,
+        list: Option<&[(u32, u32)]>,
+        (start, len): (u64, usize),
+        merge: Option<Merge>,
+        spare: Option<&std::sync::Mutex<Vec<Buffers>>>,
+    ) -> Vec<Chunk> {
+        (0..len.div_ceil(CHUNK))
+            .into_par_iter()
+            .map_init(Vec::new, |buf, c| {
+                let at = c * CHUNK;
+                let units = self.units_in(list, start + at as u64, CHUNK.min(len - at), buf);
+                let reuse = spare.and_then(|s| s.lock().ok().and_then(|mut v| v.pop()));
+                self.produce(units, merge, reuse)
+            })
+            .collect()
     }
 
     /// Sample `units` (pixels or quads); `merge`: see [`Recorder`];
@@ -654,8 +700,8 @@ impl Tracer<'_> {
             .map(|j| Consumer::new(j, self.layouts[j.layout], model))
             .collect::<Result<Vec<_>>>()?;
         let merge = self.merge(jobs, each.is_some());
-        let units = self.units();
-        let total = units.len() as u64;
+        let list = self.unit_list();
+        let total = self.unit_count(list.as_deref());
         let mut done = 0u64;
         // Fewer pixels per group when each read is kept in several
         // layouts: up to three groups are held at once.
@@ -664,18 +710,17 @@ impl Tracer<'_> {
         } else {
             CHUNK * 8
         };
-        let groups: Vec<&[(u32, u32)]> = units.chunks(group).collect();
+        let groups: Vec<(u64, usize)> = (0..total)
+            .step_by(group)
+            .map(|s| (s, group.min((total - s) as usize)))
+            .collect();
         let spare = std::sync::Mutex::new(Vec::<Buffers>::new());
         // Sampling (on the pool) overlaps simulation (here), unless this
         // is a pool thread: see crate::par.
         crate::par::produce_consume(
             &groups,
             2,
-            |_, g| -> Vec<Chunk> {
-                g.par_chunks(CHUNK)
-                    .map(|c| self.produce(c, merge, spare.lock().ok().and_then(|mut v| v.pop())))
-                    .collect()
-            },
+            |_, &g| -> Vec<Chunk> { self.produce_range(list.as_deref(), g, merge, Some(&spare)) },
             |_, chunks| -> Result<()> {
                 if let [one] = consumers.as_mut_slice() {
                     for c in &chunks {

@@ -143,6 +143,67 @@ impl RasterOrder {
         v
     }
 
+    /// Whether [`RasterOrder::pixel_range`] works out a range from its
+    /// start (`scanline` and `tiled:N`); for the others it walks the
+    /// order from the first pixel, and a caller wants the list instead.
+    pub fn has_ranges(self) -> bool {
+        matches!(self, RasterOrder::Scanline | RasterOrder::Tiled(_))
+    }
+
+    /// Pixels `start .. start + len` of [`RasterOrder::pixel_list`]
+    /// appended to `out` (fewer past the frame's end), without the list:
+    /// a frame's pieces made where they are used, so no thread waits for
+    /// (and no memory holds) the whole list. Worked out from `start` for
+    /// the orders of [`RasterOrder::has_ranges`].
+    pub fn pixel_range(self, frame: Frame, start: u64, len: usize, out: &mut Vec<(u32, u32)>) {
+        let (w, h) = (frame.width, frame.height);
+        let (tw, th) = match self {
+            RasterOrder::Scanline => (w.max(1), 1),
+            RasterOrder::Tiled(n) => (n.max(1), n.max(1)),
+            _ => {
+                let len = len.min(usize::MAX - out.len());
+                out.extend(self.pixels(frame).skip(start as usize).take(len));
+                return;
+            }
+        };
+        let total = frame.pixels();
+        if start >= total {
+            return;
+        }
+        let end = out.len() + len.min((total - start).try_into().unwrap_or(usize::MAX));
+        // The band of tile rows `start` is in, the tile in the band, the
+        // row in the tile and the column: every band but the last holds
+        // w·th pixels, every tile of a band but its last tw·(band height).
+        let (w64, tw64, th64) = (w as u64, tw as u64, th as u64);
+        let band = start / (w64 * th64);
+        let mut y0 = (band * th64) as u32;
+        let r = start - band * w64 * th64;
+        let hb = th64.min((h - y0) as u64);
+        let tile = r / (tw64 * hb);
+        let mut x0 = (tile * tw64) as u32;
+        let r = r - tile * tw64 * hb;
+        let wt = tw64.min((w - x0) as u64);
+        let (mut yy, mut xx) = ((r / wt) as u32, (r % wt) as u32);
+        while out.len() < end {
+            let (hb, wt) = (th.min(h - y0), tw.min(w - x0));
+            let run = (wt - xx).min((end - out.len()) as u32);
+            out.extend((xx..xx + run).map(|x| (x0 + x, y0 + yy)));
+            xx += run;
+            if xx == wt {
+                xx = 0;
+                yy += 1;
+                if yy == hb {
+                    yy = 0;
+                    x0 = x0.saturating_add(tw);
+                    if x0 >= w {
+                        x0 = 0;
+                        y0 = y0.saturating_add(th);
+                    }
+                }
+            }
+        }
+    }
+
     /// The 2×2 quads of `frame` in this order: quad `(qx, qy)` holds pixels
     /// `2qx ..= 2qx + 1` × `2qy ..= 2qy + 1` (those inside the frame), and
     /// the order runs over the ⌈W/2⌉ × ⌈H/2⌉ grid of quads, `tiled:N` in
@@ -204,6 +265,46 @@ mod tests {
         }
         for bad in ["tiled", "tiled:0", "zigzag"] {
             assert!(bad.parse::<RasterOrder>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn pixel_ranges_are_slices_of_the_list() {
+        // Awkward frames (a last band and tile shorter than the rest,
+        // tiles wider than the frame) and ranges at every kind of start.
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % n
+        };
+        for (w, h) in [(1, 1), (7, 5), (13, 29), (64, 3), (37, 41), (1, 19)] {
+            let frame = Frame::new(w, h);
+            for order in [
+                RasterOrder::Scanline,
+                RasterOrder::Tiled(1),
+                RasterOrder::Tiled(3),
+                RasterOrder::Tiled(8),
+                RasterOrder::Tiled(100),
+                RasterOrder::Morton,
+                RasterOrder::Hilbert,
+            ] {
+                let list = order.pixel_list(frame);
+                let n = list.len() as u64;
+                let mut starts: Vec<u64> = (0..n + 2).collect();
+                starts.extend((0..20).map(|_| next(n + 1)));
+                for start in starts {
+                    for len in [0, 1, 2, 5, 9, next(n + 3) as usize, usize::MAX / 2] {
+                        let mut got = vec![(u32::MAX, 0)];
+                        order.pixel_range(frame, start, len, &mut got);
+                        let s = (start as usize).min(list.len());
+                        let e = s.saturating_add(len).min(list.len());
+                        assert_eq!(got[0], (u32::MAX, 0), "kept what was there");
+                        assert_eq!(&got[1..], &list[s..e], "{order} {w}x{h} at {start}+{len}");
+                    }
+                }
+            }
         }
     }
 
