@@ -449,11 +449,7 @@ impl ChainLayout {
                 bx,
                 by,
                 morton: false,
-            } => {
-                let tile = ((y >> by) as u64 * row + (x >> bx) as u64) << (bx + by);
-                let (mx, my) = ((1u32 << bx) - 1, (1u32 << by) - 1);
-                tile + ((((y & my) << bx) | (x & mx)) as u64)
-            }
+            } => tiled_offset(row, bx, by, x, y),
             Fast::Tiled {
                 bx,
                 by,
@@ -484,30 +480,41 @@ impl ChainLayout {
         self.layout.offset(w, x, y)
     }
 
-    /// The address of texel `(x, y)` of level `level` and the byte steps
-    /// to `(x + 1, y)` and `(x, y + 1)`, when the 2×2 block at `(x, y)`
-    /// (inside the level) is laid out so: row-major levels, and tiles of
-    /// power-of-two sides when the block is inside one tile. `None`
-    /// otherwise (take [`ChainLayout::address`] per texel). The four
-    /// addresses grow in the block's read order, so the first and the last
+    /// The addresses of the 2×2 block at `(x, y)` (inside the level) in
+    /// read order, `(x, y)`, `(x + 1, y)`, `(x, y + 1)`, `(x + 1, y + 1)`,
+    /// worked out together for row-major levels and row-major tiles of
+    /// power-of-two sides (the block inside one tile or across tiles).
+    /// `None` otherwise (take [`ChainLayout::address`] per texel). The
+    /// first address is the lowest and the last the highest, so the two
     /// tell whether all four share a cache line.
     #[inline(always)]
-    pub fn block_steps(&self, level: u32, x: u32, y: u32) -> Option<(u64, u64, u64)> {
+    pub fn block_addresses(&self, level: u32, x: u32, y: u32) -> Option<[u64; 4]> {
         if self.block_shift != 0 {
             return None;
         }
         let t = self.texel;
+        let k = level as usize;
+        let (w, _, base) = self.levels[k];
+        // One match on the layout per block, not one per texel.
         match self.fast {
             Fast::Linear => {
-                let (w, _, base) = self.levels[level as usize];
-                Some((base + (y as u64 * w as u64 + x as u64) * t, t, w as u64 * t))
+                let a = base + (y as u64 * w as u64 + x as u64) * t;
+                let dy = w as u64 * t;
+                Some([a, a + t, a + dy, a + dy + t])
             }
             Fast::Tiled {
                 bx,
                 by,
                 morton: false,
-            } if (!x & ((1 << bx) - 1)) != 0 && (!y & ((1 << by) - 1)) != 0 => {
-                Some((self.address(level, x, y), t, t << bx))
+            } => {
+                let row = self.rows[k];
+                let at = |x, y| base + tiled_offset(row, bx, by, x, y) * t;
+                if (!x & ((1 << bx) - 1)) != 0 && (!y & ((1 << by) - 1)) != 0 {
+                    let (a, dy) = (at(x, y), t << bx);
+                    Some([a, a + t, a + dy, a + dy + t])
+                } else {
+                    Some([at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1)])
+                }
             }
             _ => None,
         }
@@ -545,6 +552,15 @@ impl ChainLayout {
             .then(|| k as u32 - 1)
             .filter(|&k| self.sat.is_none_or(|s| address < s.2) && (k as usize) < self.levels.len())
     }
+}
+
+/// The offset in texels of `(x, y)` in row-major tiles of 2^bx × 2^by,
+/// row-major inside, `row` tiles to a row of tiles.
+#[inline(always)]
+fn tiled_offset(row: u64, bx: u32, by: u32, x: u32, y: u32) -> u64 {
+    let tile = ((y >> by) as u64 * row + (x >> bx) as u64) << (bx + by);
+    let (mx, my) = ((1u32 << bx) - 1, (1u32 << by) - 1);
+    tile + ((((y & my) << bx) | (x & mx)) as u64)
 }
 
 #[cfg(test)]
@@ -591,6 +607,58 @@ mod tests {
             sh: 4,
         };
         assert_eq!(b.offset(8, 5, 6), 57);
+    }
+
+    /// Where `block_addresses` answers, its four addresses are the SPEC
+    /// formula's for the 2×2 block, the first the lowest and the last the
+    /// highest; it answers for every block of a row-major level or of a
+    /// power-of-two tiled layout, and for no other (awkward level sizes,
+    /// several texel sizes).
+    #[test]
+    fn block_addresses_equal_the_formula() {
+        let sizes = [(37, 23), (18, 11), (9, 5), (4, 2), (2, 1), (1, 1)];
+        for layout in [
+            Layout::Linear,
+            Layout::Tiled { tw: 4, th: 4 },
+            Layout::Tiled { tw: 8, th: 2 },
+            Layout::Tiled { tw: 2, th: 16 },
+            Layout::Tiled { tw: 1, th: 1 },
+            Layout::Tiled { tw: 3, th: 4 },
+            Layout::Morton,
+            Layout::MortonTiled { tw: 4, th: 4 },
+        ] {
+            for texel in [1, 4, 16] {
+                let c = ChainLayout::new(layout, &sizes, texel);
+                let (mut blocks, mut answered) = (0, 0);
+                for (k, &(w, h)) in sizes.iter().enumerate() {
+                    for y in 0..h.saturating_sub(1) {
+                        for x in 0..w.saturating_sub(1) {
+                            blocks += 1;
+                            let Some(a) = c.block_addresses(k as u32, x, y) else {
+                                continue;
+                            };
+                            answered += 1;
+                            let f = |x, y| c.address_plain(k as u32, x, y);
+                            assert_eq!(
+                                a,
+                                [f(x, y), f(x + 1, y), f(x, y + 1), f(x + 1, y + 1)],
+                                "{layout} texel {texel} level {k} ({x}, {y})"
+                            );
+                            assert!(a.iter().all(|&b| a[0] <= b && b <= a[3]), "{a:?}");
+                        }
+                    }
+                }
+                let per_texel = matches!(
+                    layout,
+                    Layout::Morton | Layout::MortonTiled { .. } | Layout::Tiled { tw: 3, .. }
+                );
+                assert_eq!(
+                    answered,
+                    if per_texel { 0 } else { blocks },
+                    "{layout} {texel}"
+                );
+            }
+        }
     }
 
     /// Block-compressed chains: the texels of one 4×4 block share its
