@@ -117,28 +117,14 @@ fn hilbert_d2xy(n: u64, d: u64) -> (u32, u32) {
 }
 
 impl RasterOrder {
-    /// [`RasterOrder::pixels`] collected (with plain loops for `scanline`
-    /// and `tiled:N`, the common orders).
+    /// [`RasterOrder::pixels`] collected (by [`RasterOrder::pixel_range`]'s
+    /// plain loops for `scanline` and `tiled:N`, the common orders).
     pub fn pixel_list(self, frame: Frame) -> Vec<(u32, u32)> {
-        let (w, h) = (frame.width, frame.height);
         let mut v = Vec::with_capacity(frame.pixels() as usize);
-        match self {
-            RasterOrder::Scanline => {
-                for y in 0..h {
-                    v.extend((0..w).map(|x| (x, y)));
-                }
-            }
-            RasterOrder::Tiled(n) => {
-                let n = n.max(1);
-                for y0 in (0..h).step_by(n as usize) {
-                    for x0 in (0..w).step_by(n as usize) {
-                        for y in y0..(y0 + n).min(h) {
-                            v.extend((x0..(x0 + n).min(w)).map(|x| (x, y)));
-                        }
-                    }
-                }
-            }
-            _ => v.extend(self.pixels(frame)),
+        if self.has_ranges() {
+            self.pixel_range(frame, 0, usize::MAX, &mut v);
+        } else {
+            v.extend(self.pixels(frame));
         }
         v
     }
@@ -150,7 +136,7 @@ impl RasterOrder {
         matches!(self, RasterOrder::Scanline | RasterOrder::Tiled(_))
     }
 
-    /// Pixels `start .. start + len` of [`RasterOrder::pixel_list`]
+    /// Pixels `start .. start + len` of [`RasterOrder::pixels`]
     /// appended to `out` (fewer past the frame's end), without the list:
     /// a frame's pieces made where they are used, so no thread waits for
     /// (and no memory holds) the whole list. Worked out from `start` for
@@ -269,7 +255,7 @@ mod tests {
     }
 
     #[test]
-    fn pixel_ranges_are_slices_of_the_list() {
+    fn pixel_ranges_are_slices_of_the_order() {
         // Awkward frames (a last band and tile shorter than the rest,
         // tiles wider than the frame) and ranges at every kind of start.
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
@@ -290,7 +276,9 @@ mod tests {
                 RasterOrder::Morton,
                 RasterOrder::Hilbert,
             ] {
-                let list = order.pixel_list(frame);
+                // The reference: the order's own iterator.
+                let list: Vec<(u32, u32)> = order.pixels(frame).collect();
+                assert_eq!(order.pixel_list(frame), list, "{order} {w}x{h}");
                 let n = list.len() as u64;
                 let mut starts: Vec<u64> = (0..n + 2).collect();
                 starts.extend((0..20).map(|_| next(n + 1)));
