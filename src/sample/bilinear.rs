@@ -173,28 +173,80 @@ pub(crate) fn nearest<P: Pixel, S: TexelSink>(
     let l = &c.levels[li];
     let (_, i) = floor_fast(u * l.wf);
     let (_, j) = floor_fast(v * l.hf);
-    if (i as u64) < l.w as u64 && (j as u64) < l.h as u64 {
-        l.at(&c.lut, li as u32, i as usize, j as usize, sink)
+    unpack(if (i as u64) < l.w as u64 && (j as u64) < l.h as u64 {
+        pack(l.at(&c.lut, li as u32, i as usize, j as usize, sink))
     } else {
         nearest_edge(c, li, u, v, a, sink)
+    })
+}
+
+/// An RGBA value as the out-of-line paths return it, in registers. The
+/// Rust ABI returns an `[f32; 4]` from a call that is not inlined through
+/// memory; the fast path's result then meets it in that stack slot,
+/// written as four 4-byte stores and read back as wider loads, which no
+/// x86 core forwards from the store buffer (it waits for the stores to
+/// retire: a quarter of a single nearest lookup's time). The functions
+/// that return it use the C convention (`C-unwind`: a panic stays a
+/// panic), which returns an `__m128` in one register on x86-64, where SSE
+/// is part of the base instruction set; [`pack`] makes it in registers.
+#[cfg(target_arch = "x86_64")]
+pub(crate) type Rgba = std::arch::x86_64::__m128;
+
+/// An RGBA value as the out-of-line paths return it: a C struct of four
+/// floats, which the C ABIs return in registers (AArch64: four).
+#[cfg(not(target_arch = "x86_64"))]
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rgba([f32; 4]);
+
+/// `c` as an [`Rgba`].
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(crate) fn pack(c: [f32; 4]) -> Rgba {
+    // SAFETY: SSE is part of x86-64's base instruction set.
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        std::arch::x86_64::_mm_setr_ps(c[0], c[1], c[2], c[3])
     }
+    #[cfg(not(target_arch = "x86_64"))]
+    Rgba(c)
+}
+
+/// The four channels of `c`.
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(crate) fn unpack(c: Rgba) -> [f32; 4] {
+    // SAFETY: as in `pack`.
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        use std::arch::x86_64::{_mm_cvtss_f32, _mm_shuffle_ps};
+        [
+            _mm_cvtss_f32(c),
+            _mm_cvtss_f32(_mm_shuffle_ps::<0b01_01_01_01>(c, c)),
+            _mm_cvtss_f32(_mm_shuffle_ps::<0b10_10_10_10>(c, c)),
+            _mm_cvtss_f32(_mm_shuffle_ps::<0b11_11_11_11>(c, c)),
+        ]
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    c.0
 }
 
 /// [`nearest`] in general: NaN, huge and outside coordinates, wrapping,
 /// the border colour.
 #[inline(never)]
-fn nearest_edge<P: Pixel, S: TexelSink>(
+#[allow(improper_ctypes_definitions)] // called from Rust only: see `Rgba`
+extern "C-unwind" fn nearest_edge<P: Pixel, S: TexelSink>(
     c: &Chain<P>,
     li: usize,
     u: f64,
     v: f64,
     a: &Addressing,
     sink: &mut S,
-) -> [f32; 4] {
+) -> Rgba {
     let l = &c.levels[li];
     let i = fast_floor(reduce_coordinate(u, a.wrap.u) * l.wf);
     let j = fast_floor(reduce_coordinate(v, a.wrap.v) * l.hf);
-    l.fetch(&c.lut, li as u32, i, j, a, sink)
+    pack(l.fetch(&c.lut, li as u32, i, j, a, sink))
 }
 
 /// Bilinear: the 2×2 texels around `(u·w − 0.5, v·h − 0.5)` of level `li`
@@ -229,9 +281,14 @@ pub(crate) fn bilinear<P: Pixel, S: TexelSink>(
         sink.texel(li, x + 1, y);
         sink.texel(li, x, y + 1);
         sink.texel(li, x + 1, y + 1);
-        P::bilerp([b[0], b[1], b[w], b[w + 1]], &c.lut, al, be)
+        unpack(pack(P::bilerp(
+            [b[0], b[1], b[w], b[w + 1]],
+            &c.lut,
+            al,
+            be,
+        )))
     } else {
-        bilinear_edge(c, li, u, v, a, sink)
+        unpack(bilinear_edge(c, li, u, v, a, sink))
     }
 }
 
@@ -260,14 +317,15 @@ fn axis_pair(mode: WrapMode, i: i64, size: u32) -> (Option<u32>, Option<u32>) {
 /// [`bilinear`] in general: NaN, huge and non-finite coordinates, and
 /// footprints that cross the edge of the level (each axis wrapped once).
 #[inline(never)]
-fn bilinear_edge<P: Pixel, S: TexelSink>(
+#[allow(improper_ctypes_definitions)] // called from Rust only: see `Rgba`
+extern "C-unwind" fn bilinear_edge<P: Pixel, S: TexelSink>(
     c: &Chain<P>,
     li: usize,
     u: f64,
     v: f64,
     a: &Addressing,
     sink: &mut S,
-) -> [f32; 4] {
+) -> Rgba {
     let l = &c.levels[li];
     let (i0, al) = split(reduce_coordinate(u, a.wrap.u) * l.wf - 0.5);
     let (j0, be) = split(reduce_coordinate(v, a.wrap.v) * l.hf - 0.5);
@@ -281,5 +339,5 @@ fn bilinear_edge<P: Pixel, S: TexelSink>(
     let t10 = get(x1, y0);
     let t01 = get(x0, y1);
     let t11 = get(x1, y1);
-    lerp(lerp(t00, t10, al), lerp(t01, t11, al), be)
+    pack(lerp(lerp(t00, t10, al), lerp(t01, t11, al), be))
 }

@@ -481,6 +481,33 @@ macro_rules! with_chain {
 }
 pub(crate) use with_chain;
 
+/// The storage type of a [`Store`] variant: `P::of(store)` is the chain
+/// when `store` holds `Chain<P>`. A function monomorphised for one
+/// storage reads its chain with it instead of dispatching per call.
+pub(crate) trait Stored: Pixel {
+    fn of(store: &Store) -> Option<&Chain<Self>>;
+}
+
+macro_rules! stored {
+    ($($v:ident: $p:ty),*) => {$(
+        impl Stored for $p {
+            #[inline(always)]
+            fn of(store: &Store) -> Option<&Chain<Self>> {
+                match store {
+                    Store::$v(c) => Some(c),
+                    _ => None,
+                }
+            }
+        }
+    )*};
+}
+stored!(
+    U8x1: [u8; 1], U8x2: [u8; 2], U8x3: [u8; 3], U8x4: [u8; 4],
+    U16x1: [u16; 1], U16x2: [u16; 2], U16x3: [u16; 3], U16x4: [u16; 4],
+    F16x1: [f16; 1], F16x2: [f16; 2], F16x3: [f16; 3], F16x4: [f16; 4],
+    F32x1: [f32; 1], F32x2: [f32; 2], F32x3: [f32; 3], F32x4: [f32; 4]
+);
+
 impl Store {
     /// `src`'s levels as stored (all levels share `format`).
     fn new(src: &Arc<MipChain>, format: &Format) -> Option<Store> {

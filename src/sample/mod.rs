@@ -661,6 +661,7 @@ impl Sampler {
         let lod = Lod::new(&options, wf, hf, chain.len());
         #[cfg(target_arch = "x86_64")]
         let simd = simd_table(&chain);
+        let paths = one::pick(kernel, &options, &chain.store);
         Ok(Sampler {
             chain,
             options,
@@ -671,7 +672,7 @@ impl Sampler {
             },
             lod,
             sat: None,
-            paths: one::pick(kernel, &options),
+            paths,
             #[cfg(target_arch = "x86_64")]
             simd,
         })
@@ -742,7 +743,7 @@ impl Sampler {
     /// Filtered linear RGBA colour at `q`.
     #[inline]
     pub fn sample(&self, q: &Query) -> [f32; 4] {
-        (self.paths.one)(self, &self.lod, &self.options, q)
+        bilinear::unpack((self.paths.one)(self, &self.lod, &self.options, q))
     }
 
     /// [`Sampler::sample`] encoded to 8 bits in the texture's own colour
@@ -801,7 +802,7 @@ impl Sampler {
                 let mut o = self.options;
                 o.lod_bias += bias;
                 let lod = Lod::new(&o, self.lod.wf, self.lod.hf, self.chain.len());
-                (self.paths.one)(self, &lod, &o, q)
+                bilinear::unpack((self.paths.one)(self, &lod, &o, q))
             }
             _ => {
                 let k = (bias as f64).exp2() as f32;

@@ -12,8 +12,8 @@
 //! runs, so the results are the same bit for bit (`tests/sample_one.rs`).
 
 use super::aniso;
-use super::bilinear::{Filters, Lin, MagMin, Near};
-use super::fetch::{Chain, Pixel, with_chain};
+use super::bilinear::{Filters, Lin, MagMin, Near, Rgba, pack};
+use super::fetch::{Chain, Pixel, Store, Stored, with_chain};
 use super::footprint::Lod;
 #[cfg(target_arch = "x86_64")]
 use super::simd;
@@ -26,7 +26,12 @@ use super::{Kernel, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
 /// `lod` and `o` are the sampler's own, or a copy with another LOD bias
 /// (`Sampler::sample_bias`); the batched kernels take theirs from the
 /// sampler and move their footprint instead.
-pub(super) type One = fn(&Sampler, &Lod, &SamplerOptions, &Query) -> [f32; 4];
+///
+/// It returns [`Rgba`] in registers, as the edge paths do (see there).
+///
+/// [`unpack`](super::bilinear::unpack) gives the four channels.
+#[allow(improper_ctypes_definitions)] // called from Rust only: see `Rgba`
+pub(super) type One = extern "C-unwind" fn(&Sampler, &Lod, &SamplerOptions, &Query) -> Rgba;
 
 /// The untraced function of a 2×2 quad whose four queries share their
 /// derivatives ([`super::quad_queries`]): λ, the levels and the probe
@@ -76,15 +81,16 @@ impl FromOptions for MagMin {
     }
 }
 
-/// The one-query and quad functions for `kernel` under `o`.
-pub(super) fn pick(kernel: Kernel, o: &SamplerOptions) -> Paths {
+/// The one-query and quad functions for `kernel` under `o` on a chain
+/// stored as `store`.
+pub(super) fn pick(kernel: Kernel, o: &SamplerOptions, store: &Store) -> Paths {
     use TexelFilter::{Linear, Nearest};
     macro_rules! by_mip {
         ($f:ty, $aniso:literal) => {
             match o.mip {
-                MipMode::None => paths::<$f, MIP_NONE, $aniso>(),
-                MipMode::Nearest => paths::<$f, MIP_NEAREST, $aniso>(),
-                MipMode::Linear => paths::<$f, MIP_LINEAR, $aniso>(),
+                MipMode::None => with_chain!(store, c => paths::<_, $f, MIP_NONE, $aniso>(c)),
+                MipMode::Nearest => with_chain!(store, c => paths::<_, $f, MIP_NEAREST, $aniso>(c)),
+                MipMode::Linear => with_chain!(store, c => paths::<_, $f, MIP_LINEAR, $aniso>(c)),
             }
         };
     }
@@ -107,10 +113,22 @@ pub(super) fn pick(kernel: Kernel, o: &SamplerOptions) -> Paths {
     }
 }
 
-fn paths<F: FromOptions, const MIP: u8, const ANISO: bool>() -> Paths {
+/// The functions for chains stored as `P` (the argument only names `P`):
+/// one per storage, so that a call has no dispatch on the storage, whose
+/// arms would meet in memory.
+fn paths<P: Stored, F: FromOptions, const MIP: u8, const ANISO: bool>(_: &Chain<P>) -> Paths {
     Paths {
-        one: texel::<F, MIP, ANISO>,
-        quad: texel_quad::<F, MIP, ANISO>,
+        one: texel::<P, F, MIP, ANISO>,
+        quad: texel_quad::<P, F, MIP, ANISO>,
+    }
+}
+
+/// The chain of `s`, stored as `P` ([`pick`] chose the functions by it).
+#[inline(always)]
+fn chain_of<P: Stored>(s: &Sampler) -> &Chain<P> {
+    match P::of(&s.chain.store) {
+        Some(c) => c,
+        None => unreachable!("a sampler's functions are picked for its chain's storage"),
     }
 }
 
@@ -122,20 +140,22 @@ fn batched_quad(s: &Sampler, qs: &[Query; 4]) -> [[f32; 4]; 4] {
 
 /// A slice of one through the batch path (EWA, the reference and the
 /// summed-area table do the same work per query either way).
-fn batched(s: &Sampler, _: &Lod, _: &SamplerOptions, q: &Query) -> [f32; 4] {
+#[allow(improper_ctypes_definitions)]
+extern "C-unwind" fn batched(s: &Sampler, _: &Lod, _: &SamplerOptions, q: &Query) -> Rgba {
     let mut out = [[0.0; 4]];
     s.run(std::slice::from_ref(q), &mut out, &mut NoTrace);
-    out[0]
+    pack(out[0])
 }
 
 /// The isotropic or footprint-assembly lookup of one query.
-fn texel<F: FromOptions, const MIP: u8, const ANISO: bool>(
+#[allow(improper_ctypes_definitions)]
+extern "C-unwind" fn texel<P: Stored, F: FromOptions, const MIP: u8, const ANISO: bool>(
     s: &Sampler,
     lod: &Lod,
     o: &SamplerOptions,
     q: &Query,
-) -> [f32; 4] {
-    with_chain!(&s.chain.store, c => texel_on::<_, F, MIP, ANISO>(s, c, lod, o, q))
+) -> Rgba {
+    pack(texel_on::<P, F, MIP, ANISO>(s, chain_of(s), lod, o, q))
 }
 
 #[inline(always)]
@@ -175,11 +195,11 @@ fn texel_on<P: Pixel, F: FromOptions, const MIP: u8, const ANISO: bool>(
 
 /// The lookups of a quad: one plan (or footprint-assembly set-up) for the
 /// four, since they share their derivatives.
-fn texel_quad<F: FromOptions, const MIP: u8, const ANISO: bool>(
+fn texel_quad<P: Stored, F: FromOptions, const MIP: u8, const ANISO: bool>(
     s: &Sampler,
     qs: &[Query; 4],
 ) -> [[f32; 4]; 4] {
-    with_chain!(&s.chain.store, c => texel_quad_on::<_, F, MIP, ANISO>(s, c, qs))
+    texel_quad_on::<P, F, MIP, ANISO>(s, chain_of(s), qs)
 }
 
 #[inline(always)]
