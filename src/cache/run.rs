@@ -29,6 +29,10 @@ const ADDRESS_MASK: u64 = (1 << ADDRESS_BITS) - 1;
 /// Pixels per sampling chunk.
 const CHUNK: usize = 8192;
 
+/// Queries made and traced at a time within a chunk (a multiple of the
+/// 8 that `AddressOnly::trace_all` plans together).
+const QUERY_BATCH: usize = 256;
+
 /// Pack an address and its level.
 #[inline]
 pub fn pack(address: u64, level: u32) -> u64 {
@@ -610,12 +614,17 @@ impl Tracer<'_> {
         let mut pixels = 0u64;
         match self.issue {
             Issue::Stream => {
-                let qs: Vec<Query> = units
-                    .iter()
-                    .filter_map(|&(x, y)| self.view.query(x, y))
-                    .collect();
-                self.trace(&qs, &mut colours, &mut sink);
-                pixels = qs.len() as u64;
+                // A few hundred queries at a time in one small vector: a
+                // chunk's 8192 (192 KiB, a fresh mapping of the allocator
+                // each time, faulted in page by page) would be written
+                // and read back through the cache hierarchy.
+                let mut qs: Vec<Query> = Vec::with_capacity(QUERY_BATCH);
+                for part in units.chunks(QUERY_BATCH) {
+                    qs.clear();
+                    qs.extend(part.iter().filter_map(|&(x, y)| self.view.query(x, y)));
+                    self.trace(&qs, &mut colours, &mut sink);
+                    pixels += qs.len() as u64;
+                }
             }
             Issue::Pixels => {
                 for &(x, y) in units {
