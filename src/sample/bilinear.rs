@@ -269,27 +269,24 @@ pub(crate) fn bilinear<P: Pixel, S: TexelSink>(
     let (fy, j0) = floor_fast(y);
     // `w − 1` cannot underflow (w ≥ 1); a 1-texel axis always wraps. NaN
     // and huge positions fail this test too (see `floor_fast`).
-    if (i0 as u64) < (l.w - 1) as u64 && (j0 as u64) < (l.h - 1) as u64 {
-        let (al, be) = ((x - fx) as f32, (y - fy) as f32);
-        let (x, y, w) = (i0 as usize, j0 as usize, l.w as usize);
-        let k = y * w + x;
-        // One bounds check for the 2×2 block (both rows).
-        let b = &l.texels[k..k + w + 2];
-        let li = li as u32;
-        let (x, y) = (x as u32, y as u32);
-        sink.texel(li, x, y);
-        sink.texel(li, x + 1, y);
-        sink.texel(li, x, y + 1);
-        sink.texel(li, x + 1, y + 1);
-        unpack(pack(P::bilerp(
-            [b[0], b[1], b[w], b[w + 1]],
-            &c.lut,
-            al,
-            be,
-        )))
-    } else {
-        unpack(bilinear_edge(c, li, u, v, a, sink))
-    }
+    unpack(
+        if (i0 as u64) < (l.w - 1) as u64 && (j0 as u64) < (l.h - 1) as u64 {
+            let (al, be) = ((x - fx) as f32, (y - fy) as f32);
+            let (x, y, w) = (i0 as usize, j0 as usize, l.w as usize);
+            let k = y * w + x;
+            // One bounds check for the 2×2 block (both rows).
+            let b = &l.texels[k..k + w + 2];
+            let li = li as u32;
+            let (x, y) = (x as u32, y as u32);
+            sink.texel(li, x, y);
+            sink.texel(li, x + 1, y);
+            sink.texel(li, x, y + 1);
+            sink.texel(li, x + 1, y + 1);
+            pack(P::bilerp([b[0], b[1], b[w], b[w + 1]], &c.lut, al, be))
+        } else {
+            bilinear_edge(c, li, u, v, a, sink)
+        },
+    )
 }
 
 /// Column (or row) indices `i` and `i + 1` after wrapping; `None` reads

@@ -161,6 +161,11 @@ fn blocks<P: Pixel, S: TexelSink, const FMA: bool, const VEC: bool>(
     out: &mut [[f32; 4]],
     sink: &mut S,
 ) {
+    // One query (`Sampler::sample`): no block of set-ups to fill.
+    if let ([q], [out]) = (queries, &mut *out) {
+        *out = read::<P, S, false, FMA, VEC>(c, a, &setup(c, a, lod, o, q), sink);
+        return;
+    }
     let mut setups = [Setup::NONE; BLOCK];
     for (qs, os) in queries.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
         for (q, st) in qs.iter().zip(setups.iter_mut()) {
