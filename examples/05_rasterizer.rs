@@ -18,7 +18,8 @@
 //! `slice` (all the frame's queries in one `sample_slice`), and the
 //! ground's queries alone in one slice with their UVs as the rasterizer
 //! made them, −30…30 (`wrapped`), and wrapped into [0, 1) by hand
-//! (`unit`). Each figure is the median of 5 timed runs.
+//! (`unit`). Each figure is the median of 9 timed runs, the columns
+//! interleaved (one run of each per round).
 //! `portable_slice` is the slice with the AVX-512 paths off
 //! (`Sampler::set_simd(false)`): the per-lookup code a single call runs.
 //! `--only NAME` times that filter alone.
@@ -456,17 +457,29 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// M lookups/s of `f` over `n` lookups: median of 5 runs.
-fn rate(n: usize, mut f: impl FnMut()) -> f64 {
-    f();
-    let runs: Vec<f64> = (0..5)
-        .map(|_| {
+/// Timed rounds per column ([`rates`]).
+const ROUNDS: usize = 9;
+
+/// M lookups/s of each column `(n, f)` (`f` does `n` lookups): every
+/// column run once to warm up, then [`ROUNDS`] rounds that each run every
+/// column once, each round starting at the next column; the median of
+/// each column's rounds. Interleaved so that a column's neighbours in
+/// the table were timed seconds apart, not a whole column apart: on a
+/// VM whose speed drifts over seconds, ratios of columns timed one after
+/// the other drift with it.
+fn rates(cols: &mut [(usize, &mut dyn FnMut())]) -> Vec<f64> {
+    cols.iter_mut().for_each(|(_, f)| f());
+    let mut runs = vec![Vec::with_capacity(ROUNDS); cols.len()];
+    for round in 0..ROUNDS {
+        for k in 0..cols.len() {
+            let c = (round + k) % cols.len();
+            let (n, f) = &mut cols[c];
             let t = Instant::now();
             f();
-            n as f64 / t.elapsed().as_secs_f64() / 1e6
-        })
-        .collect();
-    median(runs)
+            runs[c].push(*n as f64 / t.elapsed().as_secs_f64() / 1e6);
+        }
+    }
+    runs.into_iter().map(median).collect()
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -603,60 +616,65 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             continue;
         }
         let sam = samplers(&textures, SamplerOptions::from_name(name)?);
-        let single = rate(frags.len(), || {
-            for f in &frags {
-                black_box(sam[f.texture].sample(black_box(&f.query)));
-            }
-        });
-        let quad = rate(quad_uv.len() * 4, || {
-            for (t, uv) in &quad_uv {
-                black_box(sam[*t].sample_quad(black_box(uv)));
-            }
-        });
-        let mut colours = vec![[0f32; 4]; queries.len()];
-        // The frame's queries with their textures, as a deferred renderer
-        // batches them: one slice per texture.
-        let per_texture: [Vec<Query>; 2] = [
-            frags
-                .iter()
-                .filter(|f| f.texture == 0)
-                .map(|f| f.query)
-                .collect(),
-            frags
-                .iter()
-                .filter(|f| f.texture == 1)
-                .map(|f| f.query)
-                .collect(),
-        ];
-        let slice = rate(queries.len(), || {
-            for (t, qs) in per_texture.iter().enumerate() {
-                sam[t].sample_slice(qs, &mut colours[..qs.len()]).unwrap();
-            }
-            black_box(&colours);
-        });
-        let wrapped = rate(ground.len(), || {
-            sam[0]
-                .sample_slice(&ground, &mut colours[..ground.len()])
-                .unwrap();
-            black_box(&colours);
-        });
-        let unit_rate = rate(unit.len(), || {
-            sam[0]
-                .sample_slice(&unit, &mut colours[..unit.len()])
-                .unwrap();
-            black_box(&colours);
-        });
         // The same slices with the AVX-512 paths off: the per-lookup code
         // a single call runs, batched (single / this is what a call costs
         // beyond the lookup itself).
         let mut plain = samplers(&textures, SamplerOptions::from_name(name)?);
         plain.iter_mut().for_each(|s| s.set_simd(false));
-        let portable = rate(queries.len(), || {
-            for (t, qs) in per_texture.iter().enumerate() {
-                plain[t].sample_slice(qs, &mut colours[..qs.len()]).unwrap();
-            }
-            black_box(&colours);
+        // The frame's queries with their textures, as a deferred renderer
+        // batches them: one slice per texture.
+        let per_texture: [Vec<Query>; 2] = [0, 1].map(|t| {
+            frags
+                .iter()
+                .filter(|f| f.texture == t)
+                .map(|f| f.query)
+                .collect()
         });
+        // One output buffer per column: the columns' closures live
+        // together.
+        let mut buffers: [Vec<[f32; 4]>; 4] =
+            std::array::from_fn(|_| vec![[0f32; 4]; queries.len()]);
+        let [b_slice, b_wrapped, b_unit, b_portable] = &mut buffers;
+        let by_texture = |sam: &[Sampler; 2], out: &mut [[f32; 4]]| {
+            for (t, qs) in per_texture.iter().enumerate() {
+                sam[t].sample_slice(qs, &mut out[..qs.len()]).unwrap();
+            }
+            black_box(&out);
+        };
+        let mut single = || {
+            for f in &frags {
+                black_box(sam[f.texture].sample(black_box(&f.query)));
+            }
+        };
+        let mut quad = || {
+            for (t, uv) in &quad_uv {
+                black_box(sam[*t].sample_quad(black_box(uv)));
+            }
+        };
+        let mut slice = || by_texture(&sam, b_slice);
+        let mut wrapped = || {
+            sam[0]
+                .sample_slice(&ground, &mut b_wrapped[..ground.len()])
+                .unwrap();
+            black_box(&b_wrapped);
+        };
+        let mut unit_slice = || {
+            sam[0]
+                .sample_slice(&unit, &mut b_unit[..unit.len()])
+                .unwrap();
+            black_box(&b_unit);
+        };
+        let mut portable_slice = || by_texture(&plain, b_portable);
+        let r = rates(&mut [
+            (frags.len(), &mut single),
+            (quad_uv.len() * 4, &mut quad),
+            (queries.len(), &mut slice),
+            (ground.len(), &mut wrapped),
+            (unit.len(), &mut unit_slice),
+            (queries.len(), &mut portable_slice),
+        ]);
+        let [single, quad, slice, wrapped, unit_rate, portable] =
+            [r[0], r[1], r[2], r[3], r[4], r[5]];
         rows.push(format!(
             "{{\"name\": \"{name}\", \"single_mps\": {single:.2}, \"quad_mps\": {quad:.2}, \
              \"slice_mps\": {slice:.2}, \"portable_slice_mps\": {portable:.2}, \
