@@ -608,6 +608,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ))
         })
         .collect();
+    // The frame's queries with their textures, as a deferred renderer
+    // batches them: one slice per texture.
+    let per_texture: [Vec<Query>; 2] = [0, 1].map(|t| {
+        frags
+            .iter()
+            .filter(|f| f.texture == t)
+            .map(|f| f.query)
+            .collect()
+    });
     let mut rows = Vec::new();
     // `--only NAME` times one filter (for a profiler's run).
     let only = value("--only");
@@ -621,15 +630,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // beyond the lookup itself).
         let mut plain = samplers(&textures, SamplerOptions::from_name(name)?);
         plain.iter_mut().for_each(|s| s.set_simd(false));
-        // The frame's queries with their textures, as a deferred renderer
-        // batches them: one slice per texture.
-        let per_texture: [Vec<Query>; 2] = [0, 1].map(|t| {
-            frags
-                .iter()
-                .filter(|f| f.texture == t)
-                .map(|f| f.query)
-                .collect()
-        });
         // One output buffer per column: the columns' closures live
         // together.
         let mut buffers: [Vec<[f32; 4]>; 4] =
