@@ -19,6 +19,7 @@
 //! on awkward level sizes and on queries far outside [0, 1), with NaN
 //! and infinite coordinates and derivatives.
 
+use super::layout::Lanes;
 use crate::sample::Method;
 use crate::sample::footprint::{Lod, Plan};
 use crate::sample::{MipMode, Query, Sampler, SamplerOptions, TexelFilter, TexelSink};
@@ -39,6 +40,10 @@ pub struct AddressOnly {
     /// magnification and minification filter.
     #[cfg(target_arch = "x86_64")]
     lanes: Option<(crate::sample::simd::Planner, bool)>,
+    /// The level sizes as 8-lane tables for [`super::lanes::cells8`]
+    /// (with `lanes`, for chains of up to 16 levels).
+    #[cfg(target_arch = "x86_64")]
+    sizes: Option<super::lanes::Sizes>,
 }
 
 impl AddressOnly {
@@ -68,6 +73,8 @@ impl AddressOnly {
             lod: Lod::new(&o, wf, hf, levels.len()),
             options: o,
             wrap: o.wrap,
+            #[cfg(target_arch = "x86_64")]
+            sizes: lanes.and_then(|_| super::lanes::Sizes::new(&levels)),
             levels,
             #[cfg(target_arch = "x86_64")]
             lanes,
@@ -91,26 +98,43 @@ impl AddressOnly {
 
     /// [`AddressOnly::trace_blocks`] of every query of `qs` in order:
     /// on CPUs with the sampler's AVX-512 paths, the level plans and
-    /// wrapped coordinates of 8 queries at a time in registers (the same
-    /// operations, so the same reads; the lanes those do not cover, and
-    /// the last few queries, one by one).
+    /// wrapped coordinates of 8 queries at a time in registers, and then
+    /// the texels (and, for a sink with [`BlockSink::lanes`], their
+    /// addresses) of each level choice of the 8 ([`super::lanes`]): the
+    /// same operations, so the same reads; the lanes those do not cover,
+    /// and the last few queries, one by one.
     #[inline]
     pub(crate) fn trace_all<S: BlockSink>(&self, qs: &[Query], sink: &mut S) {
         #[cfg(target_arch = "x86_64")]
-        if let Some((planner, linear)) = self.lanes {
+        if let (Some((planner, linear)), Some(sizes)) = (self.lanes, &self.sizes) {
+            // The filters are the same either way (`lanes`).
+            let bilinear = self.options.min == TexelFilter::Linear;
+            let layout = sink.lanes().cloned();
+            let (mut fine, mut coarse) = Default::default();
             let (q8s, rest) = qs.as_chunks::<8>();
             for q8 in q8s {
                 let p = planner.plans8(&self.lod, &self.options, linear, q8);
+                let l = layout.as_ref();
+                // SAFETY: a `Planner` exists only on CPUs with AVX-512.
+                #[allow(unsafe_code)]
+                unsafe {
+                    use super::lanes::cells8;
+                    cells8(sizes, &p.hi, &p.u, &p.v, bilinear, l, &mut fine);
+                    // Mip mode nearest reads one level.
+                    if linear {
+                        cells8(sizes, &p.lo, &p.u, &p.v, bilinear, l, &mut coarse);
+                    }
+                }
                 for (i, q) in q8.iter().enumerate() {
                     if p.exact >> i & 1 == 0 {
                         self.trace_blocks(q, sink);
                         continue;
                     }
                     let (hi, lo) = (p.hi[i] as usize, p.lo[i] as usize);
-                    // The filters are the same either way (`lanes`).
-                    self.filter(false, hi, p.u[i], p.v[i], sink);
+                    let lane = (i, p.u[i], p.v[i]);
+                    self.put_lane(&fine, hi, lane, bilinear, layout.is_some(), sink);
                     if p.delta[i] > 0.0 && lo != hi {
-                        self.filter(false, lo, p.u[i], p.v[i], sink);
+                        self.put_lane(&coarse, lo, lane, bilinear, layout.is_some(), sink);
                     }
                 }
             }
@@ -118,6 +142,33 @@ impl AddressOnly {
             return;
         }
         qs.iter().for_each(|q| self.trace_blocks(q, sink));
+    }
+
+    /// Lane `i` of `c` at level `li`: its block or texel (by address when
+    /// `addressed`) when inside the level, else the portable filter from
+    /// `(u, v)`.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn put_lane<S: BlockSink>(
+        &self,
+        c: &super::lanes::Cells8,
+        li: usize,
+        (i, u, v): (usize, f64, f64),
+        bilinear: bool,
+        addressed: bool,
+        sink: &mut S,
+    ) {
+        if c.inside >> i & 1 == 0 {
+            self.filter(false, li, u, v, sink);
+            return;
+        }
+        let level = li as u32;
+        match (bilinear, addressed) {
+            (true, true) => sink.block_at(level, [c.at[0][i], c.at[1][i], c.at[2][i], c.at[3][i]]),
+            (true, false) => sink.block(level, c.x[i] as u32, c.y[i] as u32),
+            (false, true) => sink.texel_at(level, c.at[0][i]),
+            (false, false) => sink.texel(level, c.x[i] as u32, c.y[i] as u32),
+        }
     }
 
     /// [`AddressOnly::trace`] to a sink that takes a bilinear block at
@@ -217,6 +268,30 @@ pub(crate) trait BlockSink: TexelSink {
         self.texel(level, x + 1, y);
         self.texel(level, x, y + 1);
         self.texel(level, x + 1, y + 1);
+    }
+
+    /// The sink's layout, when it takes texels by address
+    /// ([`BlockSink::texel_at`], [`BlockSink::block_at`]) and
+    /// [`ChainLayout::lanes`](super::layout::ChainLayout::lanes) covers
+    /// it; `None` (the default): by
+    /// coordinates only.
+    fn lanes(&self) -> Option<&Lanes> {
+        None
+    }
+
+    /// The texel of `level` at address `a` of [`BlockSink::lanes`]'s
+    /// layout (called only when that is given).
+    fn texel_at(&mut self, level: u32, a: u64) {
+        let _ = (level, a);
+        unreachable!("texel_at on a sink without lanes");
+    }
+
+    /// The 2×2 block of `level` at addresses `a` of [`BlockSink::lanes`]'s
+    /// layout, in [`BlockSink::block`]'s order (called only when that is
+    /// given).
+    fn block_at(&mut self, level: u32, a: [u64; 4]) {
+        let _ = (level, a);
+        unreachable!("block_at on a sink without lanes");
     }
 }
 

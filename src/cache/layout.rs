@@ -520,6 +520,38 @@ impl ChainLayout {
         }
     }
 
+    /// What [`crate::cache::isotropic`]'s 8-lane address code needs of this
+    /// layout: row-major levels or row-major tiles of power-of-two sides
+    /// (the two [`ChainLayout::block_addresses`] works out), texels as the
+    /// unit, at most [`LANE_LEVELS`] levels; `None` otherwise.
+    pub(crate) fn lanes(&self) -> Option<Lanes> {
+        if self.block_shift != 0 || self.levels.len() > LANE_LEVELS {
+            return None;
+        }
+        let (bx, by) = match self.fast {
+            // Row-major levels are tiles of one texel, a row of tiles
+            // being a row of texels (`Fast::row`).
+            Fast::Linear => (0, 0),
+            Fast::Tiled {
+                bx,
+                by,
+                morton: false,
+            } => (bx, by),
+            _ => return None,
+        };
+        let mut l = Lanes {
+            bx,
+            by,
+            texel: self.texel,
+            base: [0; LANE_LEVELS],
+            row: [0; LANE_LEVELS],
+        };
+        for (k, (&(_, _, base), &row)) in self.levels.iter().zip(&self.rows).enumerate() {
+            (l.base[k], l.row[k]) = (base, row);
+        }
+        Some(l)
+    }
+
     /// [`ChainLayout::address`] by [`Layout::offset`], the formula as
     /// SPEC.md states it (the reference the address is tested against).
     pub fn address_plain(&self, level: u32, x: u32, y: u32) -> u64 {
@@ -552,6 +584,20 @@ impl ChainLayout {
             .then(|| k as u32 - 1)
             .filter(|&k| self.sat.is_none_or(|s| address < s.2) && (k as usize) < self.levels.len())
     }
+}
+
+/// Levels [`ChainLayout::lanes`] covers: two registers of 8 lanes.
+pub(crate) const LANE_LEVELS: usize = 16;
+
+/// A layout as [`ChainLayout::lanes`] gives it: texel `(x, y)` of level
+/// `k` is at `base[k] + tiled_offset(row[k], bx, by, x, y) · texel`.
+#[derive(Clone, Debug)]
+pub(crate) struct Lanes {
+    pub bx: u32,
+    pub by: u32,
+    pub texel: u64,
+    pub base: [u64; LANE_LEVELS],
+    pub row: [u64; LANE_LEVELS],
 }
 
 /// The offset in texels of `(x, y)` in row-major tiles of 2^bx × 2^by,

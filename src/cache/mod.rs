@@ -13,9 +13,12 @@
 //! filters, [`prefetch`] times the cache's misses in a prefetching texture
 //! unit. [`shape`] stands in for a texture whose values no filter reads:
 //! sizes and format only, no texel generated; [`isotropic`] reports what
-//! an isotropic lookup reads without reading it.
+//! an isotropic lookup reads without reading it ([`lanes`]: 8 at a time
+//! with AVX-512).
 
 pub mod isotropic;
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 pub mod layout;
 pub mod prefetch;
 pub mod reference;

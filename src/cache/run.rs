@@ -14,7 +14,7 @@ use std::io::{BufRead, Write};
 use rayon::prelude::*;
 
 use super::isotropic::{AddressOnly, BlockSink};
-use super::layout::ChainLayout;
+use super::layout::{ChainLayout, Lanes};
 use super::prefetch::{Prefetch, PrefetchStats, Timing};
 use super::sim::{AddressSpace, CacheConfig, Outcome, Policy, Simulator, Stats};
 use crate::error::{Error, Result};
@@ -163,6 +163,8 @@ struct Recorder<'a, const ONE: bool> {
     out: Vec<Vec<u64>>,
     counts: Vec<Vec<u32>>,
     windows: Vec<Window>,
+    /// The layout as 8-lane tables (`ONE` only, where it has them).
+    lanes: Option<Lanes>,
 }
 
 impl<'a, const ONE: bool> Recorder<'a, ONE> {
@@ -188,6 +190,7 @@ impl<'a, const ONE: bool> Recorder<'a, ONE> {
             out,
             counts,
             windows: vec![Window::default(); n],
+            lanes: if ONE { layouts[0].lanes() } else { None },
         }
     }
 
@@ -258,27 +261,41 @@ impl<const ONE: bool> BlockSink for Recorder<'_, ONE> {
     #[inline(always)]
     fn block(&mut self, level: u32, x: u32, y: u32) {
         if ONE && let Some(a) = self.layouts[0].block_addresses(level, x, y) {
-            let packed = a.map(|a| pack(a, level));
-            match self.merge {
-                Some(m) if packed[0] >> m.shift == packed[3] >> m.shift => {
-                    self.put(0, packed[0], 4, true);
-                }
-                _ => {
-                    // Four calls written out: as an array iterator the
-                    // loop was compiled out of line (15 % of the run).
-                    let [a, b, c, d] = packed;
-                    self.put(0, a, 1, true);
-                    self.put(0, b, 1, true);
-                    self.put(0, c, 1, true);
-                    self.put(0, d, 1, true);
-                }
-            }
+            self.block_at(level, a);
             return;
         }
         self.texel(level, x, y);
         self.texel(level, x + 1, y);
         self.texel(level, x, y + 1);
         self.texel(level, x + 1, y + 1);
+    }
+
+    fn lanes(&self) -> Option<&Lanes> {
+        self.lanes.as_ref()
+    }
+
+    #[inline(always)]
+    fn texel_at(&mut self, level: u32, a: u64) {
+        self.put(0, pack(a, level), 1, true);
+    }
+
+    #[inline(always)]
+    fn block_at(&mut self, level: u32, a: [u64; 4]) {
+        let packed = a.map(|a| pack(a, level));
+        match self.merge {
+            Some(m) if packed[0] >> m.shift == packed[3] >> m.shift => {
+                self.put(0, packed[0], 4, true);
+            }
+            _ => {
+                // Four calls written out: as an array iterator the loop
+                // was compiled out of line (15 % of the run).
+                let [a, b, c, d] = packed;
+                self.put(0, a, 1, true);
+                self.put(0, b, 1, true);
+                self.put(0, c, 1, true);
+                self.put(0, d, 1, true);
+            }
+        }
     }
 }
 
