@@ -179,3 +179,25 @@ fn a_sweep_writes_one_csv_row_per_configuration_and_a_plot() {
     let svg = std::fs::read_to_string(out.join("sweep.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("hit rate") && svg.contains("tiled:4x4"));
 }
+
+/// `parvo … | head`: a reader that has gone ends the run quietly with
+/// status 141 (128 + SIGPIPE, as a shell reports a filter the signal
+/// ended), not with a panic and a backtrace.
+#[test]
+fn a_closed_stdout_ends_the_run_quietly() {
+    let mut a = vec!["cachesim"];
+    a.extend(SCENE);
+    a.extend(["--cache", "4K:64:2", "--json"]);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_parvo"))
+        .args(&a)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run parvo");
+    // The reader goes before parvo writes its report.
+    drop(child.stdout.take());
+    let o = child.wait_with_output().expect("wait for parvo");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(o.status.code(), Some(141), "{stderr}");
+}

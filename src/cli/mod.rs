@@ -108,7 +108,37 @@ pub(crate) fn remove_temporary_files_on_interrupt() {
     });
 }
 
+/// Exit status of a process whose output pipe closed (128 + SIGPIPE, as a
+/// shell reports a filter the signal ended).
+const CLOSED_PIPE: i32 = 141;
+
+/// `parvo … | head`: once the reader has gone, a write to stdout fails
+/// with a broken pipe, which `println!` turns into a panic and a
+/// backtrace. End the process quietly instead, as a Unix filter ends,
+/// with the temporary files being written removed (the destinations are
+/// only ever replaced whole). Other panics keep the default report.
+fn quiet_on_closed_stdout() {
+    let report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        // std's words: "failed printing to stdout: Broken pipe (os error 32)".
+        if message.starts_with("failed printing to stdout")
+            && message.to_ascii_lowercase().contains("broken pipe")
+        {
+            parvo::io::atomic::remove_temporary_files();
+            std::process::exit(CLOSED_PIPE);
+        }
+        report(info);
+    }));
+}
+
 pub fn main() -> ExitCode {
+    quiet_on_closed_stdout();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Mip(a) => mip::run(a),
