@@ -13,7 +13,7 @@
 //! filters, [`prefetch`] times the cache's misses in a prefetching texture
 //! unit. [`shape`] stands in for a texture whose values no filter reads:
 //! sizes and format only, no texel generated; [`isotropic`] reports what
-//! an isotropic lookup reads without reading it ([`lanes`]: 8 at a time
+//! an isotropic lookup reads without reading it (8 at a time
 //! with AVX-512).
 
 pub mod isotropic;
