@@ -273,8 +273,7 @@ pub(crate) trait BlockSink: TexelSink {
     /// The sink's layout, when it takes texels by address
     /// ([`BlockSink::texel_at`], [`BlockSink::block_at`]) and
     /// [`ChainLayout::lanes`](super::layout::ChainLayout::lanes) covers
-    /// it; `None` (the default): by
-    /// coordinates only.
+    /// it; `None` (the default) when it takes them by coordinates only.
     fn lanes(&self) -> Option<&Lanes> {
         None
     }

@@ -520,7 +520,8 @@ impl ChainLayout {
         }
     }
 
-    /// What [`crate::cache::isotropic`]'s 8-lane address code needs of this
+    /// What the 8-lane address code of [`crate::cache::isotropic`]'s
+    /// `trace_all` needs of this
     /// layout: row-major levels or row-major tiles of power-of-two sides
     /// (the two [`ChainLayout::block_addresses`] works out), texels as the
     /// unit, at most [`LANE_LEVELS`] levels; `None` otherwise.
