@@ -15,7 +15,7 @@ use parvo::sample::{
 use parvo::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use parvo::{MipOptions, Texture, Wrap, WrapMode, mip};
 
-mod common;
+use crate::common;
 use common::Rng;
 
 fn presets() -> Vec<SamplerOptions> {
@@ -464,7 +464,7 @@ fn mqps(n: usize, mut f: impl FnMut()) -> f64 {
 
 /// The README table: prepared bytes per storage format and the one-thread
 /// slice rate of bilinear and trilinear lookups. A measurement, run on
-/// demand: `cargo test --release --test sample_storage -- --ignored
+/// demand: `cargo test --release --test sampling_core -- --ignored
 /// --nocapture storage_table`. It asserts what the table claims: the
 /// prepared chain is at most 1.1× the stored one.
 #[test]

@@ -12,7 +12,7 @@ use parvo::sample::{Query, Sampler, SamplerOptions, TexelCounter};
 use parvo::texel::{ChannelType, ColorSpace, Format};
 use parvo::{MipOptions, Wrap, WrapMode, mip};
 
-mod common;
+use crate::common;
 use common::Rng;
 
 /// Random queries over a few periods, with edge, NaN, infinite, huge and

@@ -29,7 +29,7 @@ fn chain(t: Texture) -> MipChain {
     mip::build(t, &MipOptions::default()).unwrap()
 }
 
-mod common;
+use crate::common;
 
 fn presets() -> Vec<SamplerOptions> {
     common::sampler_presets(16)
