@@ -14,9 +14,9 @@ use parvo::cache::layout::{ChainLayout, Layout};
 use parvo::cache::reference::PlainSimulator;
 use parvo::cache::run::{AddressSink, Job, Model, SAT_LEVEL, SceneSetup, unpack};
 use parvo::cache::shape::{self, CacheTexture};
-use parvo::cache::sim::{CacheConfig, Outcome};
+use parvo::cache::sim::CacheConfig;
 use parvo::sample::{Query, Sampler, SamplerOptions};
-use parvo::scene::{Frame, RasterOrder, Scene};
+use parvo::scene::{Frame, RasterOrder};
 use parvo::texel::{ChannelType, ColorSpace, Format};
 use parvo::{MipChain, MipOptions, Texture, builtin, mip};
 
@@ -337,13 +337,7 @@ fn plain(accesses: &[u64], cache: &CacheConfig, texel: u64, sat: u64) -> [u64; 5
         let (addr, level) = unpack(a);
         let bytes = if level == SAT_LEVEL { sat } else { texel };
         for (_, o) in sim.access(addr, bytes) {
-            c[0] += 1;
-            c[match o {
-                Outcome::Hit => 1,
-                Outcome::Cold => 2,
-                Outcome::Capacity => 3,
-                _ => 4,
-            }] += 1;
+            crate::tally(&mut c, o);
         }
     }
     c
@@ -371,54 +365,52 @@ fn a_scene_run_equals_the_plain_model_on_a_one_by_one_trace() {
         ("bilinear", "plane", "tiled:2x2", "morton", "2K:16:4"),
     ];
     for (filter, scene, layout, order, cache) in cases {
-        let sampler = Sampler::new(&chain, SamplerOptions::from_name(filter).unwrap()).unwrap();
-        let cl = ChainLayout::for_sampler(&chain, &sampler, layout.parse().unwrap());
-        let setup = SceneSetup {
-            sampler: &sampler,
-            layout: &cl,
-            scene: scene.parse::<Scene>().unwrap(),
-            frame: Frame::new(97, 61),
-            order: order.parse().unwrap(),
-        };
         let cache: CacheConfig = cache.parse().unwrap();
-        let (trace, pixels) = trace_one_by_one(&setup);
-        let want = plain(
-            &trace,
-            &cache,
-            cl.texel(),
-            cl.sat_entry().unwrap_or(cl.texel()),
-        );
-        let mut written = Vec::new();
-        let runs = [
-            setup
-                .run(&cache, None, &Model::default(), None, &|_, _| {})
-                .unwrap(),
-            setup
-                .simulate(
+        crate::with_setup(
+            &chain,
+            (filter, scene, layout, order),
+            Frame::new(97, 61),
+            |setup| {
+                let (trace, pixels) = trace_one_by_one(setup);
+                let want = plain(
+                    &trace,
                     &cache,
-                    None,
-                    &mut |a| {
-                        written.push(a);
-                        Ok(())
-                    },
-                    &|_, _| {},
-                )
-                .unwrap(),
-        ];
-        assert!(
-            written == trace,
-            "{filter} {scene}: the written trace differs"
+                    setup.layout.texel(),
+                    setup.layout.sat_entry().unwrap_or(setup.layout.texel()),
+                );
+                let mut written = Vec::new();
+                let runs = [
+                    setup
+                        .run(&cache, None, &Model::default(), None, &|_, _| {})
+                        .unwrap(),
+                    setup
+                        .simulate(
+                            &cache,
+                            None,
+                            &mut |a| {
+                                written.push(a);
+                                Ok(())
+                            },
+                            &|_, _| {},
+                        )
+                        .unwrap(),
+                ];
+                assert!(
+                    written == trace,
+                    "{filter} {scene}: the written trace differs"
+                );
+                for r in runs {
+                    let t = &r.stats.total;
+                    assert_eq!(
+                        [t.accesses, t.hits, t.cold, t.capacity, t.conflict],
+                        want,
+                        "{filter} {scene} {layout} {order} {cache}"
+                    );
+                    assert_eq!((r.pixels, r.reads), (pixels, trace.len() as u64));
+                    assert_eq!((r.quads, r.prefetch.len()), (None, 0));
+                }
+            },
         );
-        for r in runs {
-            let t = &r.stats.total;
-            assert_eq!(
-                [t.accesses, t.hits, t.cold, t.capacity, t.conflict],
-                want,
-                "{filter} {scene} {layout} {order} {cache}"
-            );
-            assert_eq!((r.pixels, r.reads), (pixels, trace.len() as u64));
-            assert_eq!((r.quads, r.prefetch.len()), (None, 0));
-        }
     }
 }
 
@@ -435,13 +427,7 @@ fn plain_per_level(accesses: &[u64], cache: &CacheConfig, levels: usize) -> Vec<
             level as usize
         };
         for (_, o) in sim.access(addr, 4) {
-            c[k][0] += 1;
-            c[k][match o {
-                Outcome::Hit => 1,
-                Outcome::Cold => 2,
-                Outcome::Capacity => 3,
-                _ => 4,
-            }] += 1;
+            crate::tally(&mut c[k], o);
         }
     }
     c
@@ -477,68 +463,66 @@ fn merged_runs_count_what_the_plain_model_counts_per_level() {
         ("nearest", "plane", "tiled:8x2", "tiled:4", 200, 90),
     ];
     for (filter, scene, layout, order, w, h) in cases {
-        let sampler = Sampler::new(&chain, SamplerOptions::from_name(filter).unwrap()).unwrap();
-        let cl = ChainLayout::for_sampler(&chain, &sampler, layout.parse().unwrap());
-        let setup = SceneSetup {
-            sampler: &sampler,
-            layout: &cl,
-            scene: scene.parse::<Scene>().unwrap(),
-            frame: Frame::new(w, h),
-            order: order.parse().unwrap(),
-        };
-        assert!(w * h > 2 * 8192, "the frame spans several chunks");
-        let (trace, pixels) = trace_one_by_one(&setup);
-        let levels = chain.len();
-        let check = |r: &parvo::cache::run::RunStats, cache: &CacheConfig, what: &str| {
-            let want = plain_per_level(&trace, cache, levels);
-            for (k, c) in r.stats.per_level.iter().enumerate() {
+        crate::with_setup(
+            &chain,
+            (filter, scene, layout, order),
+            Frame::new(w, h),
+            |setup| {
+                assert!(w * h > 2 * 8192, "the frame spans several chunks");
+                let (trace, pixels) = trace_one_by_one(setup);
+                let levels = chain.len();
+                let check = |r: &parvo::cache::run::RunStats, cache: &CacheConfig, what: &str| {
+                    let want = plain_per_level(&trace, cache, levels);
+                    for (k, c) in r.stats.per_level.iter().enumerate() {
+                        assert_eq!(
+                            [c.accesses, c.hits, c.cold, c.capacity, c.conflict],
+                            want[k],
+                            "{what}: {filter} {scene} {layout} {order} {cache} level {k}"
+                        );
+                    }
+                    let counted: u64 = r.stats.per_level.iter().map(|c| c.accesses).sum();
+                    assert_eq!(counted, trace.len() as u64, "{what} {cache}");
+                    assert_eq!((r.pixels, r.reads), (pixels, trace.len() as u64));
+                };
+                for cache in &caches {
+                    let r = setup
+                        .run(cache, None, &Model::default(), None, &|_, _| {})
+                        .unwrap();
+                    check(&r, cache, "one cache");
+                }
+                // Every cache at once (window: the fewest ways, or one line for
+                // the FIFO and random ones), and the LRU ones alone (window 4).
+                let layouts = [setup.layout];
+                for set in [&caches[..], &[caches[0], caches[3], caches[7]][..]] {
+                    let jobs: Vec<Job> = set
+                        .iter()
+                        .map(|&l1| Job {
+                            layout: 0,
+                            l1,
+                            l2: None,
+                        })
+                        .collect();
+                    let runs = setup
+                        .run_jobs(&layouts, &jobs, &Model::default(), &|_, _| {})
+                        .unwrap();
+                    for (r, j) in runs.iter().zip(&jobs) {
+                        check(r, &j.l1, "sweep");
+                    }
+                }
+                // A second level behind a 4-way LRU first level.
+                let (l1, l2): (CacheConfig, CacheConfig) =
+                    ("2K:64:4".parse().unwrap(), "16K:64:8".parse().unwrap());
+                let merged = setup
+                    .run(&l1, Some(&l2), &Model::default(), None, &|_, _| {})
+                    .unwrap();
+                let unmerged = setup
+                    .simulate(&l1, Some(&l2), &mut |_| Ok(()), &|_, _| {})
+                    .unwrap();
                 assert_eq!(
-                    [c.accesses, c.hits, c.cold, c.capacity, c.conflict],
-                    want[k],
-                    "{what}: {filter} {scene} {layout} {order} {cache} level {k}"
+                    merged.stats, unmerged.stats,
+                    "{filter} {scene}: with a second level"
                 );
-            }
-            let counted: u64 = r.stats.per_level.iter().map(|c| c.accesses).sum();
-            assert_eq!(counted, trace.len() as u64, "{what} {cache}");
-            assert_eq!((r.pixels, r.reads), (pixels, trace.len() as u64));
-        };
-        for cache in &caches {
-            let r = setup
-                .run(cache, None, &Model::default(), None, &|_, _| {})
-                .unwrap();
-            check(&r, cache, "one cache");
-        }
-        // Every cache at once (window: the fewest ways, or one line for
-        // the FIFO and random ones), and the LRU ones alone (window 4).
-        let layouts = [&cl];
-        for set in [&caches[..], &[caches[0], caches[3], caches[7]][..]] {
-            let jobs: Vec<Job> = set
-                .iter()
-                .map(|&l1| Job {
-                    layout: 0,
-                    l1,
-                    l2: None,
-                })
-                .collect();
-            let runs = setup
-                .run_jobs(&layouts, &jobs, &Model::default(), &|_, _| {})
-                .unwrap();
-            for (r, j) in runs.iter().zip(&jobs) {
-                check(r, &j.l1, "sweep");
-            }
-        }
-        // A second level behind a 4-way LRU first level.
-        let (l1, l2): (CacheConfig, CacheConfig) =
-            ("2K:64:4".parse().unwrap(), "16K:64:8".parse().unwrap());
-        let merged = setup
-            .run(&l1, Some(&l2), &Model::default(), None, &|_, _| {})
-            .unwrap();
-        let unmerged = setup
-            .simulate(&l1, Some(&l2), &mut |_| Ok(()), &|_, _| {})
-            .unwrap();
-        assert_eq!(
-            merged.stats, unmerged.stats,
-            "{filter} {scene}: with a second level"
+            },
         );
     }
 }

@@ -15,7 +15,7 @@ use parvo::cache::layout::ChainLayout;
 use parvo::cache::prefetch::{Prefetch, PrefetchStats, Timing};
 use parvo::cache::reference::PlainSimulator;
 use parvo::cache::run::{AddressSink, Model, SAT_LEVEL, SceneSetup, unpack};
-use parvo::cache::sim::{CacheConfig, Outcome};
+use parvo::cache::sim::CacheConfig;
 use parvo::sample::{Sampler, SamplerOptions};
 use parvo::scene::{Frame, Scene};
 use parvo::{MipChain, MipOptions, builtin, mip};
@@ -81,49 +81,41 @@ fn quad_requests_equal_the_brute_force_set_of_lines_per_quad() {
         ("sat", "zoom", "tiled:8x8", "tiled:5", "2K:128:1"),
     ];
     for (filter, scene, layout, order, cache) in cases {
-        let sampler = Sampler::new(&chain, SamplerOptions::from_name(filter).unwrap()).unwrap();
-        let cl = ChainLayout::for_sampler(&chain, &sampler, layout.parse().unwrap());
-        let setup = SceneSetup {
-            sampler: &sampler,
-            layout: &cl,
-            scene: scene.parse::<Scene>().unwrap(),
-            frame: Frame::new(45, 31),
-            order: order.parse().unwrap(),
-        };
         let cache: CacheConfig = cache.parse().unwrap();
-        let (quads, pixels, reads) = quad_lines(&setup, cache.line);
-        let mut plain = PlainSimulator::new(&cache);
-        let mut want = [0u64; 5];
-        for lines in &quads {
-            for &l in lines {
-                for (_, o) in plain.access(l * cache.line, 1) {
-                    want[0] += 1;
-                    want[match o {
-                        Outcome::Hit => 1,
-                        Outcome::Cold => 2,
-                        Outcome::Capacity => 3,
-                        _ => 4,
-                    }] += 1;
+        crate::with_setup(
+            &chain,
+            (filter, scene, layout, order),
+            Frame::new(45, 31),
+            |setup| {
+                let (quads, pixels, reads) = quad_lines(setup, cache.line);
+                let mut plain = PlainSimulator::new(&cache);
+                let mut want = [0u64; 5];
+                for lines in &quads {
+                    for &l in lines {
+                        for (_, o) in plain.access(l * cache.line, 1) {
+                            crate::tally(&mut want, o);
+                        }
+                    }
                 }
-            }
-        }
-        let model = Model {
-            quads: true,
-            prefetch: Vec::new(),
-        };
-        let r = setup.run(&cache, None, &model, None, &|_, _| {}).unwrap();
-        let t = &r.stats.total;
-        let what = format!("{filter} {scene} {layout} {order} {cache}");
-        assert_eq!(
-            [t.accesses, t.hits, t.cold, t.capacity, t.conflict],
-            want,
-            "{what}"
+                let model = Model {
+                    quads: true,
+                    prefetch: Vec::new(),
+                };
+                let r = setup.run(&cache, None, &model, None, &|_, _| {}).unwrap();
+                let t = &r.stats.total;
+                let what = format!("{filter} {scene} {layout} {order} {cache}");
+                assert_eq!(
+                    [t.accesses, t.hits, t.cold, t.capacity, t.conflict],
+                    want,
+                    "{what}"
+                );
+                assert_eq!(r.quads, Some(quads.len() as u64), "{what}");
+                assert_eq!((r.pixels, r.reads), (pixels, reads), "{what}");
+                // Merging only removes requests: fewer than reads, and the quad's
+                // four pixels share lines.
+                assert!(t.accesses < reads, "{what}");
+            },
         );
-        assert_eq!(r.quads, Some(quads.len() as u64), "{what}");
-        assert_eq!((r.pixels, r.reads), (pixels, reads), "{what}");
-        // Merging only removes requests: fewer than reads, and the quad's
-        // four pixels share lines.
-        assert!(t.accesses < reads, "{what}");
     }
 }
 
