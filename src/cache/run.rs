@@ -151,6 +151,53 @@ impl Window {
     }
 }
 
+/// One layout's recording in a [`Recorder`]: the packed accesses, their
+/// counts (when merging) and the window.
+#[derive(Debug, Default)]
+struct Track {
+    out: Vec<u64>,
+    counts: Vec<u32>,
+    window: Window,
+}
+
+impl Track {
+    /// `n` reads of the line of packed access `a` (`mergeable`: a texel,
+    /// not a table entry) under `merge`.
+    #[inline(always)]
+    fn put(&mut self, merge: Option<Merge>, a: u64, n: u32, mergeable: bool) {
+        let Some(m) = merge else {
+            self.out.push(a);
+            return;
+        };
+        let w = &mut self.window;
+        let line = a >> m.shift;
+        if mergeable && w.len > 0 {
+            if w.line[0] == line {
+                // Nothing pending: the line's entry is the last one.
+                match self.counts.last_mut() {
+                    Some(c) if w.pending[0] == 0 => *c += n,
+                    _ => w.pending[0] += n,
+                }
+                return;
+            }
+            if let Some(p) = (1..w.len).find(|&p| w.line[p] == line) {
+                w.raise(p);
+                w.pending[0] += n;
+                return;
+            }
+        }
+        w.flush(&mut self.out, &mut self.counts);
+        self.out.push(a);
+        self.counts.push(n);
+        if mergeable {
+            w.insert(line, a, m.window);
+        } else {
+            // A read outside the window's reckoning: start it afresh.
+            w.len = 0;
+        }
+    }
+}
+
 /// The recording sink of a traced frame: each read's address in every
 /// layout (a sweep traces its frame once for all of them), and, when
 /// `merge` is set, reads of lines in the window of the last few distinct
@@ -160,9 +207,10 @@ impl Window {
 struct Recorder<'a, const ONE: bool> {
     layouts: &'a [&'a ChainLayout],
     merge: Option<Merge>,
-    out: Vec<Vec<u64>>,
-    counts: Vec<Vec<u32>>,
-    windows: Vec<Window>,
+    /// The first layout's track, held here (the hot case of one layout
+    /// reaches it without a load through a vector), then the others'.
+    first: Track,
+    rest: Vec<Track>,
     /// The layout as 8-lane tables (`ONE` only, where it has them).
     lanes: Option<Lanes>,
 }
@@ -182,14 +230,25 @@ impl<'a, const ONE: bool> Recorder<'a, ONE> {
         counts.resize_with(n, || {
             Vec::with_capacity(if merge.is_some() { reserve } else { 0 })
         });
-        out.iter_mut().for_each(Vec::clear);
-        counts.iter_mut().for_each(Vec::clear);
+        let mut tracks = out
+            .into_iter()
+            .zip(counts)
+            .take(n)
+            .map(|(mut out, mut counts)| {
+                out.clear();
+                counts.clear();
+                Track {
+                    out,
+                    counts,
+                    window: Window::default(),
+                }
+            });
+        let first = tracks.next().unwrap_or_default();
         Recorder {
             layouts,
             merge,
-            out,
-            counts,
-            windows: vec![Window::default(); n],
+            first,
+            rest: tracks.collect(),
             lanes: if ONE { layouts[0].lanes() } else { None },
         }
     }
@@ -198,59 +257,31 @@ impl<'a, const ONE: bool> Recorder<'a, ONE> {
     /// (`mergeable`: a texel, not a table entry).
     #[inline(always)]
     fn put(&mut self, i: usize, a: u64, n: u32, mergeable: bool) {
-        let out = &mut self.out[i];
-        let Some(m) = self.merge else {
-            out.push(a);
-            return;
-        };
-        let counts = &mut self.counts[i];
-        let w = &mut self.windows[i];
-        let line = a >> m.shift;
-        if mergeable && w.len > 0 {
-            if w.line[0] == line {
-                // Nothing pending: the line's entry is the last one.
-                match counts.last_mut() {
-                    Some(c) if w.pending[0] == 0 => *c += n,
-                    _ => w.pending[0] += n,
-                }
-                return;
-            }
-            if let Some(p) = (1..w.len).find(|&p| w.line[p] == line) {
-                w.raise(p);
-                w.pending[0] += n;
-                return;
-            }
-        }
-        w.flush(out, counts);
-        out.push(a);
-        counts.push(n);
-        if mergeable {
-            w.insert(line, a, m.window);
+        let track = if i == 0 {
+            &mut self.first
         } else {
-            // A read outside the window's reckoning: start it afresh.
-            w.len = 0;
-        }
+            &mut self.rest[i - 1]
+        };
+        track.put(self.merge, a, n, mergeable);
     }
 
     /// Reads recorded so far (without merging).
     fn len(&self) -> usize {
-        self.out.first().map_or(0, Vec::len)
+        self.first.out.len()
     }
 
     /// The entries and counts, every pending read recorded.
-    fn finish(mut self) -> (Vec<Vec<u64>>, Vec<Vec<u32>>) {
-        if self.merge.is_none() {
-            return (self.out, Vec::new());
+    fn finish(self) -> (Vec<Vec<u64>>, Vec<Vec<u32>>) {
+        let merging = self.merge.is_some();
+        let (mut outs, mut counts) = (Vec::new(), Vec::new());
+        for mut t in std::iter::once(self.first).chain(self.rest) {
+            if merging {
+                t.window.flush(&mut t.out, &mut t.counts);
+                counts.push(t.counts);
+            }
+            outs.push(t.out);
         }
-        for ((w, out), counts) in self
-            .windows
-            .iter_mut()
-            .zip(&mut self.out)
-            .zip(&mut self.counts)
-        {
-            w.flush(out, counts);
-        }
-        (self.out, self.counts)
+        (outs, counts)
     }
 }
 
@@ -282,9 +313,25 @@ impl<const ONE: bool> BlockSink for Recorder<'_, ONE> {
     #[inline(always)]
     fn block_at(&mut self, level: u32, a: [u64; 4]) {
         let packed = a.map(|a| pack(a, level));
+        let line = |k: usize, m: Merge| packed[k] >> m.shift;
         match self.merge {
-            Some(m) if packed[0] >> m.shift == packed[3] >> m.shift => {
+            Some(m) if line(0, m) == line(3, m) => {
                 self.put(0, packed[0], 4, true);
+            }
+            // Two lines, a row (or a column) of the block in each: reads
+            // A A B B (or A B A B) are two of A, then two of B. With a
+            // window of two or more lines the second read of A in A B A B
+            // is a hit (B cannot have evicted it) and leaves A and B in
+            // the same recency order as A A B B does; a window of one
+            // (FIFO, random, direct-mapped) is left the reads as they are.
+            Some(m)
+                if m.window >= 2
+                    && ((line(0, m) == line(1, m) && line(2, m) == line(3, m))
+                        || (line(0, m) == line(2, m) && line(1, m) == line(3, m))) =>
+            {
+                let other = if line(0, m) == line(1, m) { 2 } else { 1 };
+                self.put(0, packed[0], 2, true);
+                self.put(0, packed[other], 2, true);
             }
             _ => {
                 // Four calls written out: as an array iterator the loop
