@@ -899,9 +899,8 @@ impl Consumer {
             for (&a, &n) in acc.iter().zip(counts) {
                 let (addr, bytes, level) = decode(a);
                 self.sim.access(addr, bytes, level);
-                if n > 1 {
-                    self.sim.repeat_hits(level, n as u64 - 1);
-                }
+                // `n - 1` may be 0: adding it saves a branch on data.
+                self.sim.repeat_hits(level, n as u64 - 1);
                 self.reads += n as u64;
             }
             return Ok(());

@@ -1037,7 +1037,7 @@ impl Simulator {
     /// sectors does (the fast path of [`Simulator::access`] for a repeat).
     #[inline]
     pub(crate) fn repeat_hits(&mut self, level: u32, n: u64) {
-        self.level_counters(level);
+        // The access before made the level's counters.
         self.stats.per_level[level as usize].accesses += n;
     }
 
