@@ -201,3 +201,33 @@ fn a_closed_stdout_ends_the_run_quietly() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(o.status.code(), Some(141), "{stderr}");
 }
+
+/// The simulator's AVX-512 path (taken when the CPU has it) and the portable
+/// one (`PARVO_NO_AVX=1`) print the same JSON, 3C counts included, for
+/// caches whose sets are narrower and wider than the 16-line compare.
+#[test]
+fn the_avx512_and_portable_simulators_agree() {
+    for (cache, order) in [
+        ("4K:64:2", "scanline"),
+        ("16K:64:4", "tiled:8"),
+        ("2K:32:4:fifo", "hilbert"),
+        ("1K:64:16", "scanline"),
+    ] {
+        let mut a = vec!["cachesim"];
+        a.extend(SCENE);
+        a.extend(["--cache", cache, "--order", order, "--json"]);
+        let run = |no_avx: bool| {
+            let mut c = Command::new(env!("CARGO_BIN_EXE_parvo"));
+            c.args(&a);
+            if no_avx {
+                c.env("PARVO_NO_AVX", "1");
+            } else {
+                c.env_remove("PARVO_NO_AVX");
+            }
+            let o = c.output().expect("run parvo");
+            json(&o);
+            o.stdout
+        };
+        assert_eq!(run(false), run(true), "{cache} {order}");
+    }
+}
