@@ -1222,19 +1222,14 @@ impl Simulator {
 
 #[cfg(test)]
 mod tests {
-    use super::equal_lanes;
+    use super::{equal_lanes, xorshift};
 
     /// The one-compare AVX-512 path finds the same lanes as a plain loop,
     /// on vectors with no match, one, and several (fixed-seed values).
     #[test]
     fn equal_lanes_paths_agree_with_a_loop() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = || xorshift(&mut state);
         for round in 0..2000 {
             let mut v = [0u32; 16];
             for x in v.iter_mut() {
