@@ -895,16 +895,14 @@ impl Consumer {
             // Merged repeats (see `Recorder`): no reads written, no
             // fragments.
             self.fragments += c.pixels;
-            #[cfg(target_arch = "x86_64")]
-            if crate::cpu::avx512_sample() {
-                #[allow(unsafe_code)]
-                // SAFETY: the CPU has AVX-512 F (checked just above).
-                unsafe {
-                    self.merged_wide(acc, counts)
-                };
-                return Ok(());
+            let decode = self.decode();
+            for (&a, &n) in acc.iter().zip(counts) {
+                let (addr, bytes, level) = decode(a);
+                self.sim.access(addr, bytes, level);
+                // `n - 1` may be 0: adding it saves a branch on data.
+                self.sim.repeat_hits(level, n as u64 - 1);
+                self.reads += n as u64;
             }
-            self.merged::<false>(acc, counts);
             return Ok(());
         }
         self.reads += acc.len() as u64;
@@ -930,26 +928,6 @@ impl Consumer {
         }
         self.fragments += c.ends.len() as u64;
         Ok(())
-    }
-
-    /// Merged entries through the simulator.
-    #[inline(always)]
-    fn merged<const WIDE: bool>(&mut self, acc: &[u64], counts: &[u32]) {
-        let decode = self.decode();
-        for (&a, &n) in acc.iter().zip(counts) {
-            let (addr, bytes, level) = decode(a);
-            self.sim.access_lanes::<WIDE>(addr, bytes, level);
-            // `n - 1` may be 0: adding it saves a branch on data.
-            self.sim.repeat_hits(level, n as u64 - 1);
-            self.reads += n as u64;
-        }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)]
-    #[target_feature(enable = "avx512f")]
-    unsafe fn merged_wide(&mut self, acc: &[u64], counts: &[u32]) {
-        self.merged::<true>(acc, counts);
     }
 
     /// One fragment's reads: through the cache (merged per line for a

@@ -513,7 +513,7 @@ impl Cache {
     /// Touch `line` wanting the sectors in `want`; returns the sectors that
     /// were missing (0 = hit) and the line's sectors present afterwards.
     #[inline(always)]
-    fn touch<const WIDE: bool>(&mut self, line: u64, want: u32) -> (u32, u32) {
+    fn touch(&mut self, line: u64, want: u32) -> (u32, u32) {
         let set = self.set_of(line) as usize;
         let ways = self.ways;
         let policy = self.policy;
@@ -563,7 +563,7 @@ impl Cache {
                 }
                 (want, want)
             }
-            Store::Front(f) => f.touch::<WIDE>(line, want),
+            Store::Front(f) => f.touch(line, want),
             Store::Large { .. } => self.touch_large(line, want, set),
         }
     }
@@ -686,11 +686,11 @@ impl Front {
 
     /// [`Cache::touch`].
     #[inline(always)]
-    fn touch<const WIDE: bool>(&mut self, line: u64, want: u32) -> (u32, u32) {
+    fn touch(&mut self, line: u64, want: u32) -> (u32, u32) {
         // The low halves all compared at once (which one hits is data,
         // a loop's exit would be mispredicted); the candidates, almost
         // always none or the one, checked whole.
-        let mut m = equal_lanes::<WIDE>(&self.low, line as u32);
+        let mut m = equal_lanes(&self.low, line as u32);
         let i = loop {
             if m == 0 {
                 return self.touch_back(line, want);
@@ -771,19 +771,7 @@ impl Front {
 /// Bit `i` set where `v[i] == x`: four SSE2 compares (every x86-64 has
 /// SSE2), a loop elsewhere.
 #[inline(always)]
-fn equal_lanes<const WIDE: bool>(v: &[u32; 16], x: u32) -> u32 {
-    #[cfg(target_arch = "x86_64")]
-    if WIDE {
-        use std::arch::x86_64::{
-            __m512i, _mm512_cmpeq_epi32_mask, _mm512_loadu_si512, _mm512_set1_epi32,
-        };
-        #[allow(unsafe_code)]
-        // SAFETY: only compiled into callers with AVX-512 F enabled.
-        unsafe {
-            let lanes = _mm512_loadu_si512(v.as_ptr().cast::<__m512i>());
-            return _mm512_cmpeq_epi32_mask(lanes, _mm512_set1_epi32(x as i32)) as u32;
-        }
-    }
+fn equal_lanes(v: &[u32; 16], x: u32) -> u32 {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{
@@ -1039,14 +1027,7 @@ impl Simulator {
     /// `level`, for the per-level counters).
     #[inline]
     pub fn access(&mut self, address: u64, bytes: u64, level: u32) {
-        self.access_inner::<false>(address, bytes, level, |_, _| {});
-    }
-
-    /// [`Simulator::access`], the shadow's front compared in one AVX-512
-    /// compare when `WIDE` (only in callers with AVX-512 F enabled).
-    #[inline(always)]
-    pub(crate) fn access_lanes<const WIDE: bool>(&mut self, address: u64, bytes: u64, level: u32) {
-        self.access_inner::<WIDE>(address, bytes, level, |_, _| {});
+        self.access_inner(address, bytes, level, |_, _| {});
     }
 
     /// `n` more accesses of the line the last access touched, at `level`:
@@ -1069,11 +1050,11 @@ impl Simulator {
         level: u32,
         each: &mut dyn FnMut(u64, Outcome),
     ) {
-        self.access_inner::<false>(address, bytes, level, each);
+        self.access_inner(address, bytes, level, each);
     }
 
     #[inline(always)]
-    fn access_inner<const WIDE: bool>(
+    fn access_inner(
         &mut self,
         address: u64,
         bytes: u64,
@@ -1085,13 +1066,13 @@ impl Simulator {
         let (first, last) = (address >> self.line_shift, end >> self.line_shift);
         if first == last && self.sector_shift == self.line_shift {
             // The common case: one line, no sectors.
-            let o = self.touch_line::<WIDE>(first, 1, level);
+            let o = self.touch_line(first, 1, level);
             each(first, o);
             return;
         }
         for line in first..=last {
             let want = self.sectors(address, end, line);
-            let o = self.touch_line::<WIDE>(line, want, level);
+            let o = self.touch_line(line, want, level);
             each(line, o);
         }
     }
@@ -1145,26 +1126,20 @@ impl Simulator {
         }
         for &(line, want, level) in &group {
             self.level_counters(level);
-            let o = self.touch_line::<false>(line, want, level);
+            let o = self.touch_line(line, want, level);
             each(line, o);
         }
         self.group = group;
     }
 
     #[inline(always)]
-    fn touch_line<const WIDE: bool>(&mut self, line: u64, want: u32, level: u32) -> Outcome {
+    fn touch_line(&mut self, line: u64, want: u32, level: u32) -> Outcome {
         if line == self.last_line && want & !self.last_mask == 0 {
             self.stats.per_level[level as usize].accesses += 1;
             return Outcome::Hit;
         }
-        let (missing, held) = self.l1.touch::<WIDE>(line, want);
-        // Not `map`: a closure would be a function of its own, without the
-        // caller's target features.
-        #[allow(clippy::manual_map)]
-        let shadow = match self.shadow.as_mut() {
-            Some(s) => Some(s.touch::<WIDE>(line, want)),
-            None => None,
-        };
+        let (missing, held) = self.l1.touch(line, want);
+        let shadow = self.shadow.as_mut().map(|s| s.touch(line, want));
         self.last_line = line;
         self.last_mask = held & shadow.map_or(u32::MAX, |s| s.1);
         if missing == 0 {
@@ -1208,51 +1183,13 @@ impl Simulator {
                 let (s0, s1) = (lo >> self.l2_sector_shift, hi >> self.l2_sector_shift);
                 let want = (((1u64 << (s1 + 1)) - 1) as u32) & !(((1u64 << s0) - 1) as u32);
                 let want = want & (((1u64 << self.l2_sectors) - 1) as u32);
-                let (miss, _) = l2.touch::<false>(l, want);
+                let (miss, _) = l2.touch(l, want);
                 let o = if miss == 0 {
                     Outcome::Hit
                 } else {
                     Outcome::Miss
                 };
                 c.add(o, miss.count_ones() as u64 * (1u64 << self.l2_sector_shift));
-            }
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{equal_lanes, xorshift};
-
-    /// The one-compare AVX-512 path finds the same lanes as a plain loop,
-    /// on vectors with no match, one, and several (fixed-seed values).
-    #[test]
-    fn equal_lanes_paths_agree_with_a_loop() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || xorshift(&mut state);
-        for round in 0..2000 {
-            let mut v = [0u32; 16];
-            for x in v.iter_mut() {
-                // A small alphabet so repeats (several matching lanes) occur.
-                *x = if round % 2 == 0 {
-                    (next() % 5) as u32
-                } else {
-                    next() as u32
-                };
-            }
-            let x = if round % 3 == 0 {
-                v[(next() % 16) as usize]
-            } else {
-                (next() % 5) as u32
-            };
-            let want = v
-                .iter()
-                .enumerate()
-                .fold(0u32, |m, (i, &e)| m | (((e == x) as u32) << i));
-            assert_eq!(equal_lanes::<false>(&v, x), want, "{v:?} {x}");
-            #[cfg(target_arch = "x86_64")]
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                assert_eq!(equal_lanes::<true>(&v, x), want, "{v:?} {x}");
             }
         }
     }
