@@ -17,7 +17,8 @@
 //! overlap work with polling or consuming only on a thread that is not in
 //! the pool, whose waiting keeps no pool thread from running the work.
 
-use std::sync::mpsc;
+use std::collections::VecDeque;
+use std::sync::{Condvar, Mutex, MutexGuard, mpsc};
 use std::time::Duration;
 
 /// True when the calling thread is a worker of a rayon pool.
@@ -58,50 +59,194 @@ pub fn polled<T: Send>(
     })
 }
 
-/// Produces one item per element of `inputs` (each production may use
-/// rayon) and hands the items to `consume` in order on this thread. Off
-/// the pool, production runs on a thread of its own up to `ahead` items
-/// ahead of the consumer, so the two overlap; on a pool thread each item
+/// Produces items `0 .. n` (`produce(i)`, which may use rayon) and hands
+/// them to `consume` in order on this thread, at most `ahead` items
+/// produced beyond the one being consumed. Off the pool, as many threads
+/// as rayon's pool has do the work: this one and the others each take the
+/// next item not yet taken and produce it, and this one consumes the
+/// items in order, producing only while the next one to consume is not
+/// ready. Production and consumption overlap; no thread waits for the
+/// slowest item of a batch; and there are no more threads than cores
+/// (with one more, a consumer that must keep up gets a third of each
+/// core's time instead of the half it needs). On a pool thread each item
 /// is produced in place, then consumed (see the module docs). Stops at
-/// the first error of `consume`.
-pub fn produce_consume<I: Sync, T: Send, E>(
-    inputs: &[I],
+/// the first error of `consume`; a panic in `produce` is resumed on this
+/// thread.
+pub fn produce_consume<T: Send, E>(
+    n: usize,
     ahead: usize,
-    produce: impl Fn(usize, &I) -> T + Sync,
-    mut consume: impl FnMut(usize, T) -> Result<(), E>,
+    produce: impl Fn(usize) -> T + Sync,
+    consume: impl FnMut(usize, T) -> Result<(), E>,
 ) -> Result<(), E> {
     if on_pool_thread() {
-        for (i, x) in inputs.iter().enumerate() {
-            consume(i, produce(i, x))?;
+        return threads_produce_consume(1, n, ahead, produce, consume);
+    }
+    threads_produce_consume(rayon::current_num_threads(), n, ahead, produce, consume)
+}
+
+/// [`produce_consume`] off the pool on `threads` threads (this one and
+/// `threads - 1` others), or in place on this one for 1.
+fn threads_produce_consume<T: Send, E>(
+    threads: usize,
+    n: usize,
+    ahead: usize,
+    produce: impl Fn(usize) -> T + Sync,
+    mut consume: impl FnMut(usize, T) -> Result<(), E>,
+) -> Result<(), E> {
+    if threads <= 1 {
+        for i in 0..n {
+            consume(i, produce(i))?;
         }
         return Ok(());
     }
-    let (tx, rx) = mpsc::sync_channel::<(usize, T)>(ahead.max(1));
+    let stream = Stream {
+        state: Mutex::new(StreamState {
+            next: 0,
+            consumed: 0,
+            ready: VecDeque::new(),
+            stop: false,
+        }),
+        n,
+        ahead: ahead.max(1),
+        ready: Condvar::new(),
+        room: Condvar::new(),
+    };
+    let others = threads.min(n).saturating_sub(1);
     std::thread::scope(|scope| {
-        let produce = &produce;
-        let producer = scope.spawn(move || {
-            for (i, x) in inputs.iter().enumerate() {
-                // The consumer stopped early (an error): stop producing.
-                if tx.send((i, produce(i, x))).is_err() {
-                    return;
-                }
+        let (stream, produce) = (&stream, &produce);
+        let producers: Vec<_> = (0..others)
+            .map(|_| scope.spawn(move || stream.produce_all(produce)))
+            .collect();
+        let result = {
+            // A panic here (in `produce` or `consume`) must release the
+            // other threads before the scope waits for them.
+            let _guard = StopOnPanic(stream);
+            (0..n).try_for_each(|i| match stream.take(produce) {
+                Some(item) => consume(i, item),
+                None => Ok(()), // A producer panicked: resumed below.
+            })
+        };
+        stream.stop();
+        for p in producers {
+            if let Err(p) = p.join() {
+                std::panic::resume_unwind(p);
             }
-        });
-        let mut result = Ok(());
-        for (i, item) in rx.iter() {
-            if let Err(e) = consume(i, item) {
-                result = Err(e);
-                break;
-            }
-        }
-        // Dropping the receiver (end of this scope's borrow) lets a
-        // producer blocked on a full channel return.
-        drop(rx);
-        if let Err(p) = producer.join() {
-            std::panic::resume_unwind(p);
         }
         result
     })
+}
+
+/// [`produce_consume`]'s items between its threads.
+struct Stream<T> {
+    state: Mutex<StreamState<T>>,
+    n: usize,
+    ahead: usize,
+    /// Signalled when the next item to consume is ready (or production
+    /// stopped).
+    ready: Condvar,
+    /// Signalled when an item is consumed (or production stopped).
+    room: Condvar,
+}
+
+struct StreamState<T> {
+    /// The next item no thread has taken.
+    next: usize,
+    /// Items consumed so far.
+    consumed: usize,
+    /// Items `consumed ..`: produced (`Some`) or not yet.
+    ready: VecDeque<Option<T>>,
+    /// Set when the consumer stops or a thread panicked.
+    stop: bool,
+}
+
+/// Sets `stop` when dropped during a panic, so that the other threads
+/// stop waiting for an item that will never come.
+struct StopOnPanic<'a, T>(&'a Stream<T>);
+
+impl<T> Drop for StopOnPanic<'_, T> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.stop();
+        }
+    }
+}
+
+impl<T> Stream<T> {
+    fn lock(&self) -> MutexGuard<'_, StreamState<T>> {
+        // Nothing panics while holding the lock: a poisoned lock still
+        // holds consistent state.
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn stop(&self) {
+        self.lock().stop = true;
+        self.ready.notify_all();
+        self.room.notify_all();
+    }
+
+    /// Take the next item when there is one and it is within `ahead`.
+    fn claim(&self, s: &mut StreamState<T>) -> Option<usize> {
+        (!s.stop && s.next < self.n && s.next < s.consumed + self.ahead).then(|| {
+            s.next += 1;
+            s.next - 1
+        })
+    }
+
+    /// Put produced item `i` in its place.
+    fn put(&self, i: usize, item: T) -> MutexGuard<'_, StreamState<T>> {
+        let mut s = self.lock();
+        let k = i - s.consumed;
+        if s.ready.len() <= k {
+            s.ready.resize_with(k + 1, || None);
+        }
+        s.ready[k] = Some(item);
+        s
+    }
+
+    /// A producing thread: take the next item, produce it, put it in its
+    /// place, until every item is taken or production stops.
+    fn produce_all(&self, produce: &impl Fn(usize) -> T) {
+        let _guard = StopOnPanic(self);
+        let mut s = self.lock();
+        loop {
+            if let Some(i) = self.claim(&mut s) {
+                drop(s);
+                let item = produce(i);
+                s = self.put(i, item);
+                if i == s.consumed {
+                    self.ready.notify_one();
+                }
+            } else if s.stop || s.next >= self.n {
+                return;
+            } else {
+                s = self.room.wait(s).unwrap_or_else(|e| e.into_inner());
+            }
+        }
+    }
+
+    /// The consumer: the next item in order, producing items meanwhile
+    /// while it is not ready; `None` when production stopped first.
+    fn take(&self, produce: &impl Fn(usize) -> T) -> Option<T> {
+        let mut s = self.lock();
+        loop {
+            if let Some(Some(_)) = s.ready.front() {
+                let item = s.ready.pop_front().flatten();
+                s.consumed += 1;
+                drop(s);
+                self.room.notify_all();
+                return item;
+            }
+            if let Some(i) = self.claim(&mut s) {
+                drop(s);
+                let item = produce(i);
+                s = self.put(i, item);
+            } else if s.stop {
+                return None;
+            } else {
+                s = self.ready.wait(s).unwrap_or_else(|e| e.into_inner());
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -130,9 +275,12 @@ mod tests {
                         );
                         let mut b = 0u64;
                         produce_consume(
-                            &[1u64, 2, 3],
+                            3,
                             1,
-                            |_, &k| (0..1000u64).into_par_iter().map(|x| x * k).sum::<u64>(),
+                            |i| {
+                                let k = i as u64 + 1;
+                                (0..1000u64).into_par_iter().map(|x| x * k).sum::<u64>()
+                            },
                             |_, s| {
                                 b += s;
                                 Ok::<(), ()>(())
@@ -179,9 +327,9 @@ mod tests {
     fn produce_consume_stops_at_the_first_error_in_order() {
         let mut seen = Vec::new();
         let r = produce_consume(
-            &[0, 1, 2, 3, 4, 5],
+            6,
             2,
-            |i, &x| i * 10 + x,
+            |i| i * 11,
             |i, v| {
                 seen.push(v);
                 if i == 2 { Err(i) } else { Ok(()) }
@@ -189,5 +337,89 @@ mod tests {
         );
         assert_eq!(r, Err(2));
         assert_eq!(seen, vec![0, 11, 22]);
+    }
+
+    /// Every item is produced once and consumed once, in order, never
+    /// more than `ahead` beyond the one being consumed, whatever the
+    /// threads, counts and production times (pseudo-random, fixed seed).
+    #[test]
+    fn produce_consume_hands_over_every_item_once_in_order_within_ahead() {
+        let mut seed = 0x2545_f491_u64;
+        for threads in 1..=4 {
+            for n in [0usize, 1, 2, 5, 37] {
+                for ahead in [1usize, 2, 16] {
+                    let delays: Vec<u64> = (0..n)
+                        .map(|_| crate::cache::sim::xorshift(&mut seed) % 300)
+                        .collect();
+                    let produced: Vec<AtomicUsize> = (0..n).map(|_| AtomicUsize::new(0)).collect();
+                    let entered = AtomicUsize::new(0);
+                    let mut seen = Vec::new();
+                    threads_produce_consume(
+                        threads,
+                        n,
+                        ahead,
+                        |i| {
+                            // Taken within `ahead` of the item being
+                            // consumed (the next one may be handed over
+                            // and not yet entered).
+                            let at = entered.load(Ordering::SeqCst);
+                            assert!(i <= at + 1 + ahead, "item {i} taken at {at}, ahead {ahead}");
+                            std::thread::sleep(Duration::from_micros(delays[i]));
+                            produced[i].fetch_add(1, Ordering::SeqCst);
+                            i * 3 + 1
+                        },
+                        |i, v| {
+                            entered.store(i, Ordering::SeqCst);
+                            seen.push((i, v));
+                            Ok::<(), ()>(())
+                        },
+                    )
+                    .unwrap();
+                    let want: Vec<(usize, usize)> = (0..n).map(|i| (i, i * 3 + 1)).collect();
+                    assert_eq!(seen, want, "{threads} threads, {n} items, ahead {ahead}");
+                    assert!(produced.iter().all(|p| p.load(Ordering::SeqCst) == 1));
+                }
+            }
+        }
+    }
+
+    /// A panic in `produce`, on the consuming thread or another, reaches
+    /// the caller with its message instead of leaving a thread waiting
+    /// (the test gives up after 20 s rather than hang).
+    #[test]
+    fn produce_consume_resumes_a_panic_of_any_thread() {
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for threads in 1..=3 {
+                for bad in [0usize, 1, 4, 9] {
+                    let r = std::panic::catch_unwind(|| {
+                        threads_produce_consume(
+                            threads,
+                            10,
+                            2,
+                            |i| {
+                                if i == bad {
+                                    panic!("item {i} fails");
+                                }
+                                std::thread::sleep(Duration::from_micros(50));
+                                i
+                            },
+                            |_, _| Ok::<(), ()>(()),
+                        )
+                    });
+                    let message = r
+                        .err()
+                        .and_then(|p| p.downcast_ref::<String>().cloned())
+                        .unwrap_or_default();
+                    let _ = tx.send((threads, bad, message));
+                }
+            }
+        });
+        for _ in 0..12 {
+            let (threads, bad, message) = rx
+                .recv_timeout(Duration::from_secs(20))
+                .expect("produce_consume hung after a panic");
+            assert_eq!(message, format!("item {bad} fails"), "{threads} threads");
+        }
     }
 }

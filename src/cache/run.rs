@@ -2,10 +2,11 @@
 //! a sampler whose texel reads become byte addresses of a chain layout, in
 //! raster order, and the addresses are simulated in that order.
 //!
-//! Sampling runs on rayon in chunks of pixels; each chunk's addresses are
-//! recorded, and the chunks are fed to the simulator in raster order on
-//! another thread while the next chunks are sampled (sampling and
-//! simulation overlap). The recorded form ([`Trace`]) packs an access into
+//! Sampling runs in chunks of pixels, on as many threads as rayon's pool
+//! has; each chunk's addresses are recorded, and the chunks are fed to the
+//! simulator in raster order by one of those threads, which samples chunks
+//! too while the next one to simulate is not ready (sampling and
+//! simulation overlap, [`crate::par::produce_consume`]). The recorded form ([`Trace`]) packs an access into
 //! one `u64`: the address in the low 56 bits, the mip level (or
 //! [`SAT_LEVEL`] for a summed-area-table entry) in the top 8.
 
@@ -444,7 +445,10 @@ impl SceneSetup<'_> {
         let tracer = self.tracer(&layouts, Issue::Stream);
         let list = tracer.unit_list();
         let n = tracer.unit_count(list.as_deref());
-        let chunks = tracer.produce_range(list.as_deref(), (0, n as usize), None, None);
+        let chunks: Vec<Chunk> = (0..(n as usize).div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| tracer.produce_chunk(list.as_deref(), c, None, None))
+            .collect();
         let n = chunks.iter().map(|c| c.accesses[0].len()).sum();
         let mut accesses = Vec::with_capacity(n);
         for c in &chunks {
@@ -632,24 +636,21 @@ impl Tracer<'_> {
         }
     }
 
-    /// The chunks of `len` units from `start`, sampled on the pool, in
-    /// order.
-    fn produce_range(
+    /// Chunk `c` of the frame's units, sampled; `merge`: see
+    /// [`Recorder`]; `reuse`: the vectors of a consumed chunk, to record
+    /// into.
+    fn produce_chunk(
         &self,
         list: Option<&[(u32, u32)]>,
-        (start, len): (u64, usize),
+        c: usize,
         merge: Option<Merge>,
-        spare: Option<&std::sync::Mutex<Vec<Buffers>>>,
-    ) -> Vec<Chunk> {
-        (0..len.div_ceil(CHUNK))
-            .into_par_iter()
-            .map_init(Vec::new, |buf, c| {
-                let at = c * CHUNK;
-                let units = self.units_in(list, start + at as u64, CHUNK.min(len - at), buf);
-                let reuse = spare.and_then(|s| s.lock().ok().and_then(|mut v| v.pop()));
-                self.produce(units, merge, reuse)
-            })
-            .collect()
+        reuse: Option<Buffers>,
+    ) -> Chunk {
+        let start = (c * CHUNK) as u64;
+        let len = CHUNK.min((self.unit_count(list) - start) as usize);
+        let mut buf = Vec::new();
+        let units = self.units_in(list, start, len, &mut buf);
+        self.produce(units, merge, reuse)
     }
 
     /// Sample `units` (pixels or quads); `merge`: see [`Recorder`];
@@ -767,8 +768,9 @@ impl Tracer<'_> {
         })
     }
 
-    /// Sample the frame in groups (on the pool) and feed every group to
-    /// every job's simulator in order (here, the jobs in parallel).
+    /// Sample the frame chunk by chunk, on as many threads as rayon's pool
+    /// has (this one among them), and feed the chunks to every job's
+    /// simulator in order, here (the jobs in parallel on the pool).
     fn simulate(
         &self,
         jobs: &[Job],
@@ -784,43 +786,37 @@ impl Tracer<'_> {
         let list = self.unit_list();
         let total = self.unit_count(list.as_deref());
         let mut done = 0u64;
-        // Fewer pixels per group when each read is kept in several
-        // layouts: up to three groups are held at once.
-        let group = if self.layouts.len() > 1 {
-            CHUNK * 2
-        } else {
-            CHUNK * 8
-        };
-        let groups: Vec<(u64, usize)> = (0..total)
-            .step_by(group)
-            .map(|s| (s, group.min((total - s) as usize)))
-            .collect();
+        let chunks = (total as usize).div_ceil(CHUNK);
+        // Chunks sampled ahead of the simulation: fewer when each read is
+        // kept in several layouts.
+        let ahead = if self.layouts.len() > 1 { 4 } else { 16 };
         let spare = std::sync::Mutex::new(Vec::<Buffers>::new());
-        // Sampling (on the pool) overlaps simulation (here), unless this
-        // is a pool thread: see crate::par.
+        // Sampling overlaps simulation, unless this is a pool thread: see
+        // crate::par.
         crate::par::produce_consume(
-            &groups,
-            2,
-            |_, &g| -> Vec<Chunk> { self.produce_range(list.as_deref(), g, merge, Some(&spare)) },
-            |_, chunks| -> Result<()> {
+            chunks,
+            ahead,
+            |c| {
+                let reuse = spare.lock().ok().and_then(|mut v| v.pop());
+                self.produce_chunk(list.as_deref(), c, merge, reuse)
+            },
+            |_, chunk| -> Result<()> {
                 if let [one] = consumers.as_mut_slice() {
-                    for c in &chunks {
-                        one.consume(c, &mut each)?;
-                    }
+                    one.consume(&chunk, &mut each)?;
                 } else {
-                    consumers.par_iter_mut().try_for_each(|k| {
-                        chunks.iter().try_for_each(|c| k.consume(c, &mut None))
-                    })?;
+                    consumers
+                        .par_iter_mut()
+                        .try_for_each(|k| k.consume(&chunk, &mut None))?;
                 }
-                done += chunks.iter().map(|c| c.units).sum::<u64>();
+                done += chunk.units;
                 progress(done, total);
                 // The next chunks record into these vectors: no new pages
                 // to fault in and zero for every chunk.
                 if let Ok(mut v) = spare.lock() {
-                    v.extend(chunks.into_iter().map(|c| Buffers {
-                        out: c.accesses,
-                        counts: c.counts,
-                    }));
+                    v.push(Buffers {
+                        out: chunk.accesses,
+                        counts: chunk.counts,
+                    });
                 }
                 Ok(())
             },
