@@ -6,9 +6,10 @@
 //! has; each chunk's addresses are recorded, and the chunks are fed to the
 //! simulator in raster order by one of those threads, which samples chunks
 //! too while the next one to simulate is not ready (sampling and
-//! simulation overlap, `par::produce_consume`). The recorded form ([`Trace`]) packs an access into
-//! one `u64`: the address in the low 56 bits, the mip level (or
-//! [`SAT_LEVEL`] for a summed-area-table entry) in the top 8.
+//! simulation overlap, `par::produce_consume`). The recorded form
+//! ([`Trace`]) packs an access into one `u64`: the address in the low 56
+//! bits, the mip level (or [`SAT_LEVEL`] for a summed-area-table entry) in
+//! the top 8.
 
 use std::io::{BufRead, Write};
 
