@@ -9,7 +9,7 @@
 //! for work that only a pool thread can run: when every pool thread is
 //! such a waiter, nobody runs the work. A batch with `--compress` hung
 //! exactly so (every worker polled for progress of an encode queued behind
-//! it: `tests/regression/compress_batch_hangs.rs`).
+//! it: `tests/files/regression/compress_batch_hangs.rs`).
 //!
 //! The rule here: a pool thread never waits outside rayon. The helpers
 //! below run the work in place when they are called on a pool thread (the

@@ -1,38 +1,8 @@
-//! Every text parser on arbitrary text: option values (layouts, cache
-//! specs, scenes, orders, frames, wrap modes, filters, sampler names,
-//! `builtin:` names) and trace lines. Parsing never panics; what parses
-//! prints back to something that parses to the same value.
+//! The `parsers` fuzz target: the body is `fuzz/bodies/parsers.rs` (see there),
+//! shared with the test that replays this target's seeds and artifacts.
 #![no_main]
 
-use libfuzzer_sys::fuzz_target;
-use parvo::Wrap;
-use parvo::cache::layout::Layout;
-use parvo::cache::sim::CacheConfig;
-use parvo::mip::MipFilter;
-use parvo::sample::SamplerOptions;
-use parvo::scene::{Frame, RasterOrder, Scene};
+#[path = "../bodies/parsers.rs"]
+mod body;
 
-fuzz_target!(|data: &[u8]| {
-    let Ok(s) = std::str::from_utf8(data) else {
-        return;
-    };
-    if let Ok(l) = s.parse::<Layout>() {
-        assert_eq!(
-            l.to_string().parse::<Layout>().ok(),
-            Some(l),
-            "layout {s:?}"
-        );
-    }
-    let _ = s.parse::<CacheConfig>();
-    if let Ok(sc) = s.parse::<Scene>() {
-        let _ = sc.to_string().parse::<Scene>();
-    }
-    let _ = s.parse::<RasterOrder>();
-    let _ = s.parse::<Frame>();
-    let _ = s.parse::<Wrap>();
-    let _ = s.parse::<MipFilter>();
-    let _ = SamplerOptions::from_name(s);
-    // Parse only: generating a built-in may be large.
-    let _ = parvo::builtin::parse(s);
-    let _ = parvo::cache::run::read_trace(s.as_bytes(), &mut |_| {});
-});
+libfuzzer_sys::fuzz_target!(|data: &[u8]| body::run(data));

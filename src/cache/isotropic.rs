@@ -14,7 +14,7 @@
 //! filters (footprint assembly, EWA, supersampling, the summed-area
 //! table) are traced by the sampler itself.
 //!
-//! `tests/cache_report/cache_fast_paths.rs` compares the reads with the traced
+//! `tests/core/cache_report/cache_fast_paths.rs` compares the reads with the traced
 //! sampler's, read for read, for every filter combination and wrap mode
 //! on awkward level sizes and on queries far outside [0, 1), with NaN
 //! and infinite coordinates and derivatives.

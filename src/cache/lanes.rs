@@ -12,7 +12,7 @@
 //! Inside a level the floor is exact either way (the portable
 //! `floor_fast` is exact below 2^51, far beyond any level), so a lane
 //! given here reads what the portable code reads, at the addresses
-//! `ChainLayout::address` gives (`tests/cache_report/cache_fast_paths.rs` compares
+//! `ChainLayout::address` gives (`tests/core/cache_report/cache_fast_paths.rs` compares
 //! whole scene runs and written traces with the traced sampler's).
 #![allow(unsafe_code)]
 

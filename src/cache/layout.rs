@@ -237,7 +237,7 @@ pub struct ChainLayout {
 
 /// [`Layout::offset`] with the tile sides as shifts when they are powers
 /// of two (the tiles GPUs use): the same offsets without a division per
-/// texel (`tests/cache_report/cache_fast_paths.rs` compares them for every texel of
+/// texel (`tests/core/cache_report/cache_fast_paths.rs` compares them for every texel of
 /// odd-sized chains). Other sides use [`Layout::offset`] itself.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Fast {

@@ -40,7 +40,7 @@
 //! share of its lost cycles that the FIFO recovers.
 //!
 //! Two properties follow from the definitions and are tested
-//! (`tests/cache_report/cache_quads_prefetch.rs`, with a hand-worked trace): with
+//! (`tests/core/cache_report/cache_quads_prefetch.rs`, with a hand-worked trace): with
 //! `D = 0` the stall-free hit rate is the cache's hit rate (for `L ≥ 1`);
 //! and every time above is a non-decreasing function of earlier times in
 //! which a deeper FIFO only ever makes `leave_{i−D−1}` an earlier leave,

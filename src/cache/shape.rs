@@ -11,7 +11,7 @@
 //! then the system's shared zero page; the isotropic filters read none,
 //! see [`super::isotropic`]). A 4096² RGBA8 texture's 85 MiB chain is
 //! then neither generated nor mip-mapped, and no page a filter does not
-//! read is touched. `tests/cache_report/cache_fast_paths.rs` checks that every such
+//! read is touched. `tests/core/cache_report/cache_fast_paths.rs` checks that every such
 //! filter's trace of a stand-in equals its trace of the texture, for
 //! textures of several formats.
 

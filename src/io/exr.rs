@@ -1212,7 +1212,7 @@ fn environment_of(
 /// A data window that is not the display window: level 0 is placed in the
 /// display window, so its size is what is allocated and is held to the
 /// limits too (an 8x8 data window in an 83886074x8 display window asked
-/// for 18 GB: tests/regression/exr_display_window_unbounded.rs); both
+/// for 18 GB: tests/files/regression/exr_display_window_unbounded.rs); both
 /// windows go into `attributes`.
 fn check_display_window(
     data_window: ::exr::meta::attribute::IntegerBounds,

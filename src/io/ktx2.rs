@@ -30,7 +30,7 @@
 //! transfer the alpha sample (channel 15) carries
 //! `KHR_DF_SAMPLE_DATATYPE_LINEAR` and no other sample does; the
 //! premultiplied flag is set only where there is an alpha channel
-//! (`tests/regression/ktx2_bc3_srgb_dfd_fails_ktx_validate.rs` checks every
+//! (`tests/files/regression/ktx2_bc3_srgb_dfd_fails_ktx_validate.rs` checks every
 //! format against an independent reading of both).
 //!
 //! Reading uses the `ktx2` crate, which validates the structure. Two

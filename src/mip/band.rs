@@ -11,7 +11,7 @@
 //! [`crate::io::exr::save_streamed`]), then the rest of the chain.
 //!
 //! Two builders, both bit for bit the whole-image chain
-//! (`tests/mip_streamed.rs`):
+//! (`tests/files/mip_streamed.rs`):
 //! - [`Streamer`], the 2×2 box of levels that halve exactly: the box row
 //!   kernel of [`super::stream`] (the whole-level build's own band kernel)
 //!   with each level's rows associated and encoded into the output type;
@@ -207,7 +207,7 @@ pub(crate) fn prefault(w: u32, h: u32, options: &MipOptions, out: Format) -> Opt
 /// soon as they exist. Level m's f32 rows are kept (1/4^m of level 0) and
 /// the rest of the chain is built from them as before. Decoding, the row
 /// kernel, association and encoding are row-local, so the chain is bit for
-/// bit the whole-image one (`tests/mip_streamed.rs`).
+/// bit the whole-image one (`tests/files/mip_streamed.rs`).
 ///
 /// [`Streamer::new`] hands the source back when the shortcut does not
 /// apply (other filters, odd sizes, alpha coverage, float sources holding
@@ -536,7 +536,7 @@ const BAND_ROWS: usize = 16;
 ///
 /// Decoding, the filter's rows, association and encoding are the
 /// whole-image build's own, row by row, so the chain is bit for bit the
-/// whole-image one (`tests/mip_streamed.rs`). Memory: the source, the
+/// whole-image one (`tests/files/mip_streamed.rs`). Memory: the source, the
 /// output chain and level 1 in f32 (a quarter of level 0 in f32), where
 /// the whole-image build holds level 0 in f32 too.
 ///

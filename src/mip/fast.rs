@@ -22,7 +22,7 @@
 //! plain colour average, as the separable path does.
 //!
 //! Every path here is compared with [`super::separable`] in
-//! `tests/mip_fast_paths_match_plain.rs`.
+//! `tests/core/mip_fast_paths_match_plain.rs`.
 
 use std::sync::OnceLock;
 

@@ -5,7 +5,7 @@
 //! rounded to the source's format once, as it is stored: a chain that
 //! reduced each level from the previous level's 8-bit codes (as some
 //! drivers and tools do) drifts by a code or more within a few levels
-//! (`tests/regression/eight_bit_chains_drift.rs`, `scripts/drift-table.py`).
+//! (`tests/files/regression/eight_bit_chains_drift.rs`, `scripts/drift-table.py`).
 //!
 //! 1. Level 0 is checked for NaN/Inf under [`NanPolicy`] (float types).
 //! 2. For each next level, [`level_size`] gives the size; the reduction runs
@@ -17,7 +17,7 @@
 //!    - the general separable path ([`separable`]) for every filter, type,
 //!      size and wrap mode, from linear f32 working levels. It is the
 //!      reference the fast paths are tested against
-//!      (`tests/mip_fast_paths_match_plain.rs`).
+//!      (`tests/core/mip_fast_paths_match_plain.rs`).
 //!    - [`reduce`] (one level, stored type in and out) keeps the integer
 //!      fast paths ([`fast`]): exact for a single reduction.
 //! 3. Optional per-level post-processing: alpha-test coverage preservation

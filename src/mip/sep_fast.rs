@@ -17,7 +17,7 @@
 //! Straight alpha, the "one alpha per row" test, the fully transparent
 //! fallback and the finite check are the plain path's own
 //! ([`super::separable::Reducer::row`]); only the order of the sums in the
-//! row kernel differs (`tests/mip_separable_fast.rs` holds every level of
+//! row kernel differs (`tests/files/mip_separable_fast.rs` holds every level of
 //! the fast chains within one code of the plain ones).
 
 use rayon::prelude::*;

@@ -16,7 +16,7 @@
 //!
 //! The sums are taken in another order than the portable kernel's (and
 //! fused), so the last bits of a value differ; the fast chains are tested
-//! against the plain path within one code (`tests/mip_separable_fast.rs`).
+//! against the plain path within one code (`tests/files/mip_separable_fast.rs`).
 
 use std::collections::HashMap;
 

@@ -11,7 +11,7 @@
 //! implementation per type and channel count), so the choice costs no
 //! branch per texel. What a fetch returns is exactly what decoding the
 //! whole level with [`crate::texel::decode_to_linear`] and expanding it
-//! with `expand_to_rgba` gives (`tests/sampling_core/sample_storage.rs` checks every
+//! with `expand_to_rgba` gives (`tests/core/sampling_core/sample_storage.rs` checks every
 //! format against that widened chain):
 //!
 //! - **`u8`**: a 256-entry table per channel (4 KiB, filled by

@@ -9,7 +9,7 @@
 //! sampler picks, when it is made, a function monomorphised for its
 //! filters, mip mode and kernel ([`pick`]); a call is then one indirect
 //! call, the plan, and the probe(s) — the same functions the batch path
-//! runs, so the results are the same bit for bit (`tests/sample_one.rs`).
+//! runs, so the results are the same bit for bit (`tests/core/sample_one.rs`).
 
 use super::aniso;
 use super::bilinear::{Filters, Lin, MagMin, Near, Rgba, pack};

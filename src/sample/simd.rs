@@ -10,7 +10,7 @@
 //! in the same order — `f64` positions, the exponent-based nearest-mip
 //! rule, the piecewise-quartic `log2`, `f32` blends as separate
 //! multiplies and adds (no fused multiply-add) — so they return exactly
-//! what the portable code returns; `tests/sampling_core/sample_simd.rs` compares the two
+//! what the portable code returns; `tests/core/sampling_core/sample_simd.rs` compares the two
 //! on random and extreme queries, and the unit tests below compare the
 //! lane-wise `log2` and level plans with the portable ones directly (a
 //! wrong level can hide behind the portable fallback). Only the way the

@@ -89,7 +89,7 @@ impl Plane {
 /// divisions, in the same order as the per-call formula (the distance
 /// test compares squares, exactly: `square_bound`), so the results are
 /// the same to the last bit
-/// (`tests/scene_view.rs` compares every pixel with that formula).
+/// (`tests/core/scene_view.rs` compares every pixel with that formula).
 ///
 /// The ray through `(sx, sy)` is `(nx, −sin p + ny·cos p, cos p + ny·sin p)`
 /// with `nx` depending on `sx` alone and `ny` on `sy` alone: the plane's

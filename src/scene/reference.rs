@@ -21,7 +21,7 @@
 //! grid (n against 2n per side): 1 sample per texel (8 to 512 per side) is
 //! within 58.1 dB PSNR of 2 on the plane (gaussian; 56.1 dB box), 55.9 dB
 //! on the tunnel and 56.1 dB on `rotate:20:6`; 0.5 is within 39 dB of 1.
-//! So the default is 1 sample per texel, and `tests/scene_reference.rs`
+//! So the default is 1 sample per texel, and `tests/files/scene_reference.rs`
 //! asserts the 1-against-2 figure stays above 50 dB on those scenes. The
 //! doubling only the minimum grid (8 to 16) accounts for most of the
 //! remaining difference (plane, gaussian: 56.6 dB), i.e. magnified pixels.

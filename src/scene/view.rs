@@ -5,7 +5,7 @@
 //!
 //! [`View::uv`] and [`View::query_at`] give the same values as
 //! [`Scene::uv`] and [`Scene::query_at`] to the last bit (the same
-//! operations in the same order on the same inputs; `tests/scene_view.rs`
+//! operations in the same order on the same inputs; `tests/core/scene_view.rs`
 //! compares every pixel of several frames with the per-call formulas).
 //! [`View::query`] of a whole pixel reads the plane's coordinates off a
 //! half-pixel grid of column and row terms ([`PlaneGrid`]), again the same

@@ -3,6 +3,8 @@
 //! formulas written independently of the library.
 #![allow(dead_code)]
 
+pub mod replay;
+
 use half::f16;
 use parvo::{AlphaMode, ChannelType, ColorSpace, Format, Texels, Texture};
 
