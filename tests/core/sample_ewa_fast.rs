@@ -91,8 +91,11 @@ fn portable_fast_ewa_is_within_1e_3_of_the_exact_weights() {
     if std::env::var_os("PARVO_NO_AVX").is_some() {
         return; // this process is already the portable run
     }
+    // The test's name within this binary: its module path less the crate.
+    let module = module_path!().split_once("::").map_or("", |(_, m)| m);
+    let name = format!("{module}::fast_ewa_is_within_1e_3_of_the_exact_weights");
     let out = std::process::Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", "fast_ewa_is_within_1e_3_of_the_exact_weights"])
+        .args(["--exact", name.trim_start_matches("::")])
         .env("PARVO_NO_AVX", "1")
         .output()
         .unwrap();
