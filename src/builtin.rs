@@ -11,7 +11,7 @@
 //!   at the border, so every level of a pyramid shows how much aliasing a
 //!   filter lets through.
 //! - `bumps`: a normal map (linear RGB8 codes `(n + 1)/2`) of Gaussian
-//!   bumps at two scales ([`crate::shade::builtin_bumps`]), for roughness
+//!   bumps at two scales ([`normals::builtin_bumps`]), for roughness
 //!   chains and `parvo render --shade`.
 //! - `photo`: a photo-like sRGB RGB8 image: fractal colour noise with
 //!   about the same energy in every octave (the 1/f² power spectrum of
@@ -28,6 +28,8 @@
 //!   height 1, whose checker grows finer without end towards the horizon.
 //!   Each texel averages 3×3 directions over its cell. The input of the
 //!   `sky` and `sphere` scenes ([`crate::scene`]).
+
+pub mod normals;
 
 use crate::error::{Error, Result};
 use crate::texel::{ChannelType, ColorSpace, Format};
@@ -123,7 +125,7 @@ pub fn parse(name: &str) -> Result<(Builtin, u32)> {
 pub fn generate(kind: Builtin, size: u32) -> Result<Texture> {
     let n = size as usize;
     match kind {
-        Builtin::Bumps => crate::shade::builtin_bumps(size),
+        Builtin::Bumps => normals::builtin_bumps(size),
         Builtin::Photo => photo(size),
         Builtin::Sky => sky(size),
         Builtin::Checker => {

@@ -71,9 +71,9 @@ pub enum Error {
     /// A setting of the mip pipeline that does not fit the job or another
     /// setting: which setting, which value, which container. Front ends
     /// say it in their own option names.
-    #[cfg(feature = "io")]
+    /// (The problem is a `pipeline::Usage`; `Usage::of` reads it back.)
     #[error("invalid option: {0}")]
-    Usage(crate::pipeline::Usage),
+    Usage(Box<dyn std::error::Error + Send + Sync>),
     /// A file or directory could not be opened, read or written.
     #[error("{action}: {error}")]
     Io {

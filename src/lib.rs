@@ -96,6 +96,7 @@ mod simd;
 pub mod store;
 pub mod texel;
 pub mod texture;
+pub mod trace;
 pub mod tradeoff;
 pub mod wrap;
 
@@ -104,5 +105,5 @@ pub use mip::{MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
 pub use sample::{Filter, Query, Sampler, SamplerOptions, TexelSink};
 pub use sat::{AccumulatorKind, SatSampler, SummedAreaTable};
 pub use texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
-pub use texture::Texture;
+pub use texture::{ImageKind, Texture};
 pub use wrap::{Wrap, WrapMode};

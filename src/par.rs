@@ -349,7 +349,12 @@ mod tests {
             for n in [0usize, 1, 2, 5, 37] {
                 for ahead in [1usize, 2, 16] {
                     let delays: Vec<u64> = (0..n)
-                        .map(|_| crate::cache::sim::xorshift(&mut seed) % 300)
+                        .map(|_| {
+                            seed ^= seed << 13;
+                            seed ^= seed >> 7;
+                            seed ^= seed << 17;
+                            seed % 300
+                        })
                         .collect();
                     let produced: Vec<AtomicUsize> = (0..n).map(|_| AtomicUsize::new(0)).collect();
                     let entered = AtomicUsize::new(0);

@@ -27,11 +27,12 @@ use crate::error::{Error, Result};
 use crate::io::{self, FileFormat, OutputKind, SaveOptions};
 use crate::mip::{self, MipFilter, MipOptions};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
-use crate::texture::Texture;
+use crate::texture::{ImageKind, Texture};
 use crate::wrap::Wrap;
 
 mod blocks;
 mod check;
+mod images;
 mod plan;
 
 pub use blocks::{BlockLevel, BlockReport, block_label};
@@ -39,7 +40,7 @@ use blocks::{compress_notes, encode_chain};
 pub use check::{Usage, check};
 pub use plan::{BuildPath, Plan};
 pub use settings::{
-    AlphaChoice, ColorChoice, ResizeTo, RoughnessSettings, RoughnessSource, Settings,
+    AlphaChoice, ColorChoice, EnvSettings, ResizeTo, RoughnessSettings, RoughnessSource, Settings,
 };
 
 mod roughness;
@@ -54,6 +55,9 @@ pub struct Job {
     pub output: PathBuf,
     /// The output container.
     pub kind: OutputKind,
+    /// Six face files (+X, −X, +Y, −Y, +Z, −Z) making one cube map
+    /// ([`Job::faces`]); empty for a job of one input.
+    pub faces: Vec<String>,
 }
 
 impl Job {
@@ -63,6 +67,23 @@ impl Job {
             input: input.to_string(),
             output: output.to_path_buf(),
             kind: OutputKind::from_path(output)?,
+            faces: Vec::new(),
+        })
+    }
+
+    /// A job building one cube map from six face files (+X, −X, +Y, −Y,
+    /// +Z, −Z) into `output`; its [`Job::input`] names them all.
+    pub fn faces(files: &[String], output: &Path) -> Result<Job> {
+        if files.len() != 6 {
+            return Err(Error::InvalidOption(format!(
+                "a cube map is built from six face files (+x -x +y -y +z -z), got {}",
+                files.len()
+            )));
+        }
+        Ok(Job {
+            input: files.join(" "),
+            faces: files.to_vec(),
+            ..Job::new(&files[0], output)?
         })
     }
 
@@ -84,6 +105,7 @@ impl Job {
                     input: input.clone(),
                     output: kind.batch_path(dir, &stem),
                     kind,
+                    faces: Vec::new(),
                 }
             })
             .collect()
@@ -185,6 +207,11 @@ pub struct Outcome {
     /// block-compressed, also when this run encoded nothing ([`Settings::update`],
     /// a dry run).
     pub block_format: Option<String>,
+    /// What the output holds: one 2-D image, an array, a cube map, an
+    /// array of them or a lat-long map.
+    pub image_kind: ImageKind,
+    /// How the job was (or, in a dry run, would be) built and written.
+    pub plan: Plan,
 }
 
 /// Something the loader or the build did that the user would not assume.
@@ -287,8 +314,9 @@ pub fn output_format(src: Format, kind: OutputKind, s: &Settings) -> Result<Form
     };
     if !kind.supports(ty) {
         return Err(Error::InvalidOption(format!(
-            "{} cannot store {ty} texels (EXR: f16, f32; PNG: u8, u16)",
-            kind.name()
+            "{} cannot store {ty} texels ({})",
+            kind.name(),
+            io::container::types_stored()
         )));
     }
     // Floats are linear light; integer outputs keep the source's encoding
@@ -351,10 +379,28 @@ struct Input {
     read_s: f64,
 }
 
+/// The plan of one job: its input read and interpreted, nothing built or
+/// written (a dry run of [`process`]).
+pub fn plan(job: &Job, s: &Settings) -> Result<Plan> {
+    let dry = Settings {
+        dry_run: true,
+        ..s.clone()
+    };
+    process(job, &dry, &mut |_| {}).map(|o| o.plan)
+}
+
 /// Runs one job (see the module docs), reporting progress to `progress`
 /// on the calling thread.
 pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Result<Outcome> {
-    let (input, prepared) = read(job, s)?;
+    let t_read = Instant::now();
+    if !job.faces.is_empty() {
+        return images::process(job, s, None, t_read, progress);
+    }
+    let (loaded, prepared) = load(job, s)?;
+    if images::holds_images(&loaded, s) {
+        return images::process(job, s, Some(loaded), t_read, progress);
+    }
+    let input = read(loaded, s, t_read)?;
     let out_format = output_format_of(job, s, input.src)?;
     let plan = Plan::new(
         job,
@@ -368,7 +414,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         let (w, h) = (input.base.width(), input.base.height());
         let full = mip::level_count(w, h, s.rounding, None);
         if s.levels.is_some_and(|n| n < full) {
-            return Err(Error::Usage(Usage::ExrLevels { full }));
+            return Err(Error::from(Usage::ExrLevels { full }));
         }
     }
     let fingerprint = io::fingerprint(
@@ -388,6 +434,8 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         notes: input.notes.clone(),
         blocks: None,
         block_format: s.compress.map(|(bf, _)| block_label(bf, out_format)),
+        image_kind: ImageKind::Plain,
+        plan: plan.clone(),
     };
     if s.dry_run {
         return Ok(outcome(Status::DryRun, &input));
@@ -403,12 +451,28 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     {
         return Ok(outcome(Status::UpToDate, &input));
     }
-    let save = SaveOptions {
-        // An EXR source's channel names carry to EXR output (N.X stays
-        // N.X, a lone Z stays Z); other sources get the layout's names.
-        channel_names: (input.src_kind == FileFormat::Exr
-            && input.channel_names.len() == out_format.channels as usize)
-            .then(|| input.channel_names.clone()),
+    // An EXR source's channel names carry to EXR output (N.X stays N.X, a
+    // lone Z stays Z); other sources get the layout's names.
+    let names = (input.src_kind == FileFormat::Exr
+        && input.channel_names.len() == out_format.channels as usize)
+        .then(|| input.channel_names.clone());
+    let save = save_options(s, &plan, input.src, fingerprint, names);
+    let mut done = outcome(Status::Written, &input);
+    build_and_write(job, s, &plan, input, prepared, &save, &mut done, progress)?;
+    Ok(done)
+}
+
+/// What a job of `plan` writes besides the levels: its wrap modes, the
+/// containers' settings, the fingerprint and parvo's attributes.
+fn save_options(
+    s: &Settings,
+    plan: &Plan,
+    src: Format,
+    fingerprint: String,
+    channel_names: Option<Vec<String>>,
+) -> SaveOptions {
+    SaveOptions {
+        channel_names,
         wrap: plan.options.wrap,
         tile: s.tile,
         compression: s.compression,
@@ -416,40 +480,33 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         supercompression: s.supercompression,
         attributes: vec![
             ("parvo:filter".into(), s.filter.to_string()),
-            ("parvo:source".into(), input.src.to_string()),
+            ("parvo:source".into(), src.to_string()),
             ("parvo:rounding".into(), s.rounding.to_string()),
         ],
-    };
-    let mut done = outcome(Status::Written, &input);
-    build_and_write(job, s, &plan, input, prepared, &save, &mut done, progress)?;
-    Ok(done)
+    }
 }
 
 /// Load `job`'s input (faulting in the fused write's buffers meanwhile,
-/// [`plan::prefault_streamed`]), interpret it under `s` and resize it.
-fn read(job: &Job, s: &Settings) -> Result<(Input, Option<Vec<Texels>>)> {
-    let t_read = Instant::now();
+/// [`plan::prefault_streamed`]), every face and layer and a recorded
+/// environment accepted: what the file holds decides the path.
+fn load(job: &Job, s: &Settings) -> Result<(io::Loaded, Option<Vec<Texels>>)> {
     // Levels 1.. of a fused box write, faulted in on the core the decoder
     // leaves idle.
     let mut prepared = None;
     let loaded = io::load_overlapped(
         &job.input,
         &s.limits,
-        &s.load,
+        &images::load_options(s),
         Some(&mut |w, h, ch, ty| prepared = plan::prefault_streamed(job, s, w, h, ch, ty)),
     )?;
-    let src_kind = loaded.info.format;
-    let file_wrap = loaded.info.wrap;
-    let mut notes: Vec<Note> = loaded.info.notes.iter().cloned().map(Note::Text).collect();
-    // Said once per file, whatever the output (a 16-bit grey height map
-    // read as sRGB changes every value of a linear output).
-    if s.color == ColorChoice::Auto && !s.normal_map {
-        notes.extend(io::assumed_color_note(&loaded.info, &loaded.base().format()).map(Note::Text));
-    }
-    let channel_names = loaded.info.channel_names.clone();
-    let mut base = loaded.into_base();
-    // Interpretation of the input.
-    let mut src = base.format();
+    Ok((loaded, prepared))
+}
+
+/// The format the build reads a source of format `f` as: its colour space
+/// and alpha as the settings say (a normal map is linear, its fourth
+/// channel data).
+fn read_as(f: Format, s: &Settings) -> Format {
+    let mut src = f;
     src.color_space = match (s.color, s.normal_map) {
         (ColorChoice::Linear, _) | (ColorChoice::Auto, true) => ColorSpace::Linear,
         (ColorChoice::Srgb, _) => ColorSpace::Srgb,
@@ -464,27 +521,60 @@ fn read(job: &Job, s: &Settings) -> Result<(Input, Option<Vec<Texels>>)> {
         AlphaChoice::Premultiplied => AlphaMode::Premultiplied,
         AlphaChoice::None => AlphaMode::None,
     };
+    src
+}
+
+/// The loader's notes, and the colour assumption said once per file
+/// (a 16-bit grey height map read as sRGB changes every value of a
+/// linear output).
+fn load_notes(loaded: &io::Loaded, s: &Settings) -> Vec<Note> {
+    let mut notes: Vec<Note> = loaded.info.notes.iter().cloned().map(Note::Text).collect();
+    if s.color == ColorChoice::Auto && !s.normal_map {
+        notes.extend(io::assumed_color_note(&loaded.info, &loaded.base().format()).map(Note::Text));
+    }
+    notes
+}
+
+/// `base` resized as [`Settings::resize_to`] asks (with the wrap modes
+/// `wrap`), and the note that says so; `base` itself when it is the
+/// size already.
+fn resize(base: Texture, s: &Settings, wrap: Wrap) -> Result<(Texture, Option<Note>)> {
+    let Some(r) = s.resize_to else {
+        return Ok((base, None));
+    };
+    let (w, h) = (base.width(), base.height());
+    let to = r.apply(w, h);
+    if to == (w, h) {
+        return Ok((base, None));
+    }
+    s.limits.check(to.0 as u64, to.1 as u64, 0)?;
+    let opts = MipOptions {
+        filter: s.filter,
+        wrap,
+        ..MipOptions::default()
+    };
+    let resized = mip::separable::reduce(&base, to.0, to.1, &opts)?.0;
+    let note = Note::Resized {
+        from: (w, h),
+        to,
+        filter: s.filter,
+    };
+    Ok((resized, Some(note)))
+}
+
+/// `loaded`, one 2-D image, interpreted under `s` and resized.
+fn read(loaded: io::Loaded, s: &Settings, t_read: Instant) -> Result<Input> {
+    let src_kind = loaded.info.format;
+    let file_wrap = loaded.info.wrap;
+    let mut notes = load_notes(&loaded, s);
+    let channel_names = loaded.info.channel_names.clone();
+    let mut base = loaded.into_base();
+    let src = read_as(base.format(), s);
     base = base.reinterpret(src)?;
     let read_s = t_read.elapsed().as_secs_f64();
-    if let Some(r) = s.resize_to {
-        let (w, h) = (base.width(), base.height());
-        let to = r.apply(w, h);
-        if to != (w, h) {
-            s.limits.check(to.0 as u64, to.1 as u64, 0)?;
-            let opts = MipOptions {
-                filter: s.filter,
-                wrap: s.wrap.or(file_wrap).unwrap_or_default(),
-                ..MipOptions::default()
-            };
-            base = mip::separable::reduce(&base, to.0, to.1, &opts)?.0;
-            notes.push(Note::Resized {
-                from: (w, h),
-                to,
-                filter: s.filter,
-            });
-        }
-    }
-    let input = Input {
+    let (base, resized) = resize(base, s, s.wrap.or(file_wrap).unwrap_or_default())?;
+    notes.extend(resized);
+    Ok(Input {
         base,
         src,
         src_kind,
@@ -492,8 +582,7 @@ fn read(job: &Job, s: &Settings) -> Result<(Input, Option<Vec<Texels>>)> {
         channel_names,
         notes,
         read_s,
-    };
-    Ok((input, prepared))
+    })
 }
 
 /// The output texel format of `job` for a source read as `src`.
@@ -503,7 +592,7 @@ fn output_format_of(job: &Job, s: &Settings, src: Format) -> Result<Format> {
         // in alpha): three or four channels whatever the source has.
         Some(r) => {
             if r.pack_alpha && src.channels == 4 {
-                return Err(Error::Usage(Usage::PackOverwritesAlpha));
+                return Err(Error::from(Usage::PackOverwritesAlpha));
             }
             let n = if r.pack_alpha { 4 } else { 3 };
             let f =
@@ -550,7 +639,7 @@ fn build_and_write(
     // output type: each group of its rows is built, compressed and written
     // (`io::exr::save_streamed`), so level 0's output buffer is neither
     // allocated nor faulted in.
-    let base = if Plan::fuses(job.kind, s) && plan.converts() {
+    let base = if plan.path == BuildPath::FusedExr {
         match write_fused(job, s, plan, input.base, src, prepared, save, progress)? {
             Ok(build_s) => {
                 out.build_s = build_s;
@@ -571,12 +660,14 @@ fn build_and_write(
     let out_format = plan.out_format;
     let options = &plan.options;
     let mut rough_levels = None;
-    let levels = if let Some(r) = &s.roughness {
+    // The plan's path decides; the roughness settings are there when it is
+    // BuildPath::Roughness.
+    let levels = if let (BuildPath::Roughness, Some(r)) = (plan.path, &s.roughness) {
         let (normals, chain) =
             roughness::build_roughness(&base, r, s, options, out_format, &mut on_progress)?;
         rough_levels = chain;
         normals
-    } else if s.normal_map {
+    } else if plan.path == BuildPath::Normal {
         // Decoded to vectors, averaged in f32, encoded once per level into
         // the output type (crate::mip::normal).
         mip::normal::build(base, options, out_format, &mut on_progress)?
@@ -614,7 +705,13 @@ fn build_and_write(
     progress(Stage::Writing);
     let t_write = Instant::now();
     match &blocks {
-        Some((chain, _)) => io::save_blocks(chain, &job.output, job.kind, save)?,
+        Some((chain, _)) => io::save_blocks(
+            std::slice::from_ref(chain),
+            ImageKind::Plain,
+            &job.output,
+            job.kind,
+            save,
+        )?,
         None => io::save(&levels, s.rounding, &job.output, job.kind, save)?,
     }
     if let (Some(levels), Some(r)) = (rough_levels, &s.roughness)

@@ -34,11 +34,32 @@ pub enum Setting {
     Levels,
     /// The alpha convention of an input (`pipeline::Settings::alpha`).
     Alpha,
+    /// The mip filter (`pipeline::Settings::filter`).
+    Filter,
+    /// Level size rounding (`pipeline::Settings::rounding`).
+    Rounding,
+    /// Alpha coverage (`pipeline::Settings::alpha_coverage`).
+    AlphaCoverage,
+    /// The input is a normal map (`pipeline::Settings::normal_map`).
+    NormalMap,
+    /// A roughness chain (`pipeline::Settings::roughness`).
+    Roughness,
+    /// The environment to build (`pipeline::EnvSettings::target`).
+    Environment,
+    /// Prefiltered specular levels (`pipeline::EnvSettings::prefilter`).
+    Prefilter,
+    /// The irradiance output (`pipeline::EnvSettings::irradiance`).
+    Irradiance,
+    /// Cube faces' size (`pipeline::EnvSettings::face_size`).
+    FaceSize,
+    /// Cube faces' edges left as filtered
+    /// (`pipeline::EnvSettings::edge_fixup` set to false).
+    NoEdgeFixup,
 }
 
 impl Setting {
     /// Every setting.
-    pub const ALL: [Setting; 10] = [
+    pub const ALL: [Setting; 20] = [
         Setting::MaxWidth,
         Setting::MaxHeight,
         Setting::MaxAlloc,
@@ -49,6 +70,16 @@ impl Setting {
         Setting::Wrap,
         Setting::Levels,
         Setting::Alpha,
+        Setting::Filter,
+        Setting::Rounding,
+        Setting::AlphaCoverage,
+        Setting::NormalMap,
+        Setting::Roughness,
+        Setting::Environment,
+        Setting::Prefilter,
+        Setting::Irradiance,
+        Setting::FaceSize,
+        Setting::NoEdgeFixup,
     ];
 
     /// The library's name of the setting, as messages show it.
@@ -64,6 +95,16 @@ impl Setting {
             Setting::Wrap => "MipOptions::wrap",
             Setting::Levels => "MipOptions::max_levels",
             Setting::Alpha => "Settings::alpha",
+            Setting::Filter => "Settings::filter",
+            Setting::Rounding => "Settings::rounding",
+            Setting::AlphaCoverage => "Settings::alpha_coverage",
+            Setting::NormalMap => "Settings::normal_map",
+            Setting::Roughness => "Settings::roughness",
+            Setting::Environment => "EnvSettings::target",
+            Setting::Prefilter => "EnvSettings::prefilter",
+            Setting::Irradiance => "EnvSettings::irradiance",
+            Setting::FaceSize => "EnvSettings::face_size",
+            Setting::NoEdgeFixup => "EnvSettings::edge_fixup=false",
         }
     }
 }

@@ -10,6 +10,74 @@ use half::f16;
 use crate::error::{Error, Result};
 use crate::texel::{self, AlphaMode, ChannelType, Format, Texels};
 
+/// What kind of image a texture is: the shape a file's images make (a
+/// 2-D texture, an array of them, a cube map, an array of cube maps, or a
+/// 2-D image holding a lat-long environment). Every loader reports it
+/// ([`crate::io::SourceInfo::kind`]), every container says which it
+/// stores, and the mip pipeline builds each by its own rule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum ImageKind {
+    /// One 2-D image (with its mip levels).
+    #[default]
+    Plain,
+    /// `layers` 2-D images of one size and format.
+    Array {
+        /// Layer count (at least 1).
+        layers: u32,
+    },
+    /// Six square faces, in the order +X, −X, +Y, −Y, +Z, −Z.
+    Cube,
+    /// `cubes` cube maps (6 × `cubes` faces, cube by cube).
+    CubeArray {
+        /// Cube count (at least 1).
+        cubes: u32,
+    },
+    /// A 2-D image holding the sphere of directions in latitude and
+    /// longitude (equirectangular), OpenImageIO's `LatLong Environment`.
+    LatLong,
+}
+
+impl ImageKind {
+    /// How many 2-D images (faces or layers, each with its own mip chain)
+    /// a texture of this kind holds.
+    pub fn images(self) -> usize {
+        match self {
+            ImageKind::Plain | ImageKind::LatLong => 1,
+            ImageKind::Array { layers } => layers as usize,
+            ImageKind::Cube => 6,
+            ImageKind::CubeArray { cubes } => 6 * cubes as usize,
+        }
+    }
+
+    /// True for a cube map or an array of them.
+    pub fn is_cube(self) -> bool {
+        matches!(self, ImageKind::Cube | ImageKind::CubeArray { .. })
+    }
+
+    /// A one-word identifier (`2d`, `array`, `cube`, `cube-array`,
+    /// `latlong`), as JSON reports give it.
+    pub fn id(self) -> &'static str {
+        match self {
+            ImageKind::Plain => "2d",
+            ImageKind::Array { .. } => "array",
+            ImageKind::Cube => "cube",
+            ImageKind::CubeArray { .. } => "cube-array",
+            ImageKind::LatLong => "latlong",
+        }
+    }
+
+    /// A short description, as `parvo info` prints it.
+    pub fn describe(self) -> String {
+        match self {
+            ImageKind::Plain => "2-D".into(),
+            ImageKind::Array { layers } => format!("2-D array, {layers} layers"),
+            ImageKind::Cube => "cube map (+x -x +y -y +z -z)".into(),
+            ImageKind::CubeArray { cubes } => format!("cube map array, {cubes} cubes"),
+            ImageKind::LatLong => "lat-long environment".into(),
+        }
+    }
+}
+
 /// One image level: `width × height` texels of one [`Format`], row-major,
 /// row 0 first (at v = 0), channels interleaved.
 #[derive(Clone, Debug, PartialEq)]

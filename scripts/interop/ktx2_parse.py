@@ -62,6 +62,32 @@ for name, extra, vk, ts, model, transfer, block, plane, need, samples in CASES:
         want = (vk, ts, N, N, 6, scheme, model, transfer, block, plane, [need(w, h) for w, h in sizes],
                 samples)
         check(got == want, f"ktx-parse finds parvo's {what} KTX2 fields as specified", f"got {got}, want {want}")
+# Block-compressed cube maps and arrays (issue 51): OpenEXR's cube strip to
+# BC6H and KTX-Software-CTS's sRGB array to BC7_SRGB. The header's face and
+# layer counts, and each level holding every face's or layer's blocks.
+peer = os.path.join(root, "tests", "data", "peer")
+IMAGES = [
+    ("BC6H cube map", os.path.join(peer, "openexr-images", "WavyLinesCube.exr"), ["--compress", "bc6h"],
+     143, 0, 6),
+    ("BC7 sRGB array", os.path.join(peer, "ktx-cts", "valid_R8G8B8A8_SRGB_2D_ARRAY.ktx2"),
+     ["--compress", "bc7", "--quality", "fast"], 146, None, 1),
+]
+for what, src, extra, vk, layers, faces in IMAGES:
+    path = f"{work}/images.ktx2"
+    r = run(parvo, "mip", src, "-o", path, *extra)
+    if not check(r.returncode == 0, f"parvo writes a {what} KTX2", r.stderr.strip()[-300:]):
+        continue
+    r = run("node", reader, path)
+    if not check(r.returncode == 0, f"ktx-parse reads parvo's {what}", r.stderr.strip()[-300:]):
+        continue
+    d = json.loads(r.stdout)
+    images = max(d["layers"], 1) * d["faces"]
+    sizes = [(max(d["width"] >> k, 1), max(d["height"] >> k, 1)) for k in range(d["levels"])]
+    got = (d["vkFormat"], d["faces"], d["uncompressed"])
+    want = (vk, faces, [images * blocks(16)(w, h) for w, h in sizes])
+    check(got == want and (layers is None or d["layers"] == layers) and (layers is not None or d["layers"] > 1),
+          f"ktx-parse finds parvo's {what}: format, faces, layers and every image's blocks per level",
+          f"got {got}, layers {d['layers']}, want {want}")
 # Two-channel data: KTX-Software-CTS's R8G8_UNORM file through parvo stays
 # R8G8_UNORM with samples R (0) and G (1), not grey + alpha.
 cts = os.path.join(root, "tests", "data", "peer", "cts_valid_R8G8_UNORM_2D.ktx2")

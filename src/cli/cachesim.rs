@@ -32,7 +32,7 @@ use parvo::cache::shape::{self, CacheTexture};
 use parvo::cache::sim::{AddressSpace, CacheConfig, Counters, Simulator, parse_size};
 use parvo::cache::sweep::{SweepRow, SweepSettings, cache_grid, sweep_with};
 
-use super::mip::ColorArg;
+use super::args::ColorArg;
 use parvo::sample::{MipMode, Sampler, SamplerOptions};
 use parvo::scene::{Frame, RasterOrder, Scene};
 
@@ -252,7 +252,7 @@ pub fn run(args: CachesimArgs) -> Result<ExitCode> {
         // The trace is written while the frame is simulated, into a
         // temporary file renamed over the destination once complete.
         Some(p) => {
-            super::remove_temporary_files_on_interrupt();
+            super::progress::remove_temporary_files_on_interrupt();
             let header = format!(
                 "# parvo cachesim trace: scene {} {}, texture {}, filter {}, layout {}, order {}, access bytes {}",
                 args.scene,
@@ -350,7 +350,8 @@ fn model(args: &CachesimArgs) -> std::result::Result<Model, String> {
         .collect();
     // The arguments' ranges are the model's: this only guards them.
     for t in &prefetch {
-        t.validate().map_err(|e| super::words(e).to_string())?;
+        t.validate()
+            .map_err(|e| super::words::words(e).to_string())?;
     }
     Ok(Model {
         quads: args.quads,
@@ -373,7 +374,7 @@ fn texture_for(args: &CachesimArgs, filters: &[SamplerOptions]) -> Result<CacheT
                 parvo::io::Limits::default().check(w, h, w * h * 4)
             })
             .and_then(|()| CacheTexture::builtin(spec))
-            .map_err(super::with_hint)
+            .map_err(super::words::with_hint)
             .with_context(|| format!("cannot read texture `{spec}`"));
     }
     let (chain, blocks) = args
@@ -403,9 +404,9 @@ fn progress_bar(args: &CachesimArgs) -> Result<Option<ProgressBar>> {
     if !std::io::stderr().is_terminal() || args.json {
         return Ok(None);
     }
-    Ok(Some(
-        ProgressBar::new(0).with_style(super::bar_style(super::BAR_COUNT)?),
-    ))
+    Ok(Some(ProgressBar::new(0).with_style(
+        super::progress::bar_style(super::progress::BAR_COUNT)?,
+    )))
 }
 
 fn trace_mode(

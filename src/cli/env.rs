@@ -8,22 +8,15 @@
 use std::io::{self, BufRead, Write};
 
 use anyhow::{Context, Result, anyhow};
-use parvo::MipOptions;
-use parvo::env::cube::{build_faces, faces_from_image, faces_from_strip};
-use parvo::env::{CubeSampler, DirQuery, Kind, LatLongSampler, latlong};
+use parvo::env::cube::build_faces;
+use parvo::env::{CubeSampler, DirQuery, LatLongSampler, latlong};
 use parvo::io::Environment;
+use parvo::io::source::interpret;
 use parvo::sample::SamplerOptions;
+use parvo::{ImageKind, MipChain, MipOptions, Texture};
 
+use super::args::EnvArg;
 use super::texture::TextureArgs;
-
-/// How `--env` reads the texture.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum EnvArg {
-    /// A lat-long (equirectangular) map, y up, as OpenImageIO reads one.
-    Latlong,
-    /// Six square faces in one image: a strip (w x 6w, 6w x w) or a cross (4w x 3w, 3w x 4w).
-    Cube,
-}
 
 /// A direction sampler of either kind.
 enum EnvSampler {
@@ -41,7 +34,8 @@ impl EnvSampler {
 }
 
 /// Build the sampler for `texture`, read as `env` or, without it, as the
-/// environment the file records; and the texture's channel count.
+/// environment the file records ([`parvo::io::source::interpret`], the
+/// library's one reading); and the texture's channel count.
 fn sampler(
     read: &TextureArgs,
     texture: &str,
@@ -52,77 +46,78 @@ fn sampler(
     let loaded = read.load_environment(texture)?;
     let channels = loaded.base().format().channels as usize;
     let kind = loaded.info.kind;
-    match kind {
-        Kind::Cube | Kind::CubeArray { .. } if env != Some(EnvArg::Latlong) => {
-            // A KTX2 or DDS cube map, or the cube --layer picks of a
-            // cube-map array: its faces, with their own levels.
-            let cube = super::sample::pick_image(texture, kind, layer)?;
-            let chains = loaded
-                .into_image_chains()
-                .with_context(|| format!("cannot read texture `{texture}`"))?;
-            return Ok((
-                EnvSampler::Cube(CubeSampler::new(&chains[6 * cube..6 * cube + 6], options)?),
-                channels,
-            ));
-        }
-        Kind::Plain | Kind::LatLong => {
-            // --layer on a texture that is not an array is refused.
-            super::sample::pick_image(texture, kind, layer)?;
-        }
-        other => {
-            return Err(anyhow!(
-                "`{texture}` is a {}: direction lookups read one cube map or a lat-long map",
-                other.describe()
-            ));
-        }
+    let direction_kind = match kind {
+        ImageKind::Cube | ImageKind::CubeArray { .. } => env != Some(EnvArg::Latlong),
+        ImageKind::Plain | ImageKind::LatLong => true,
+        ImageKind::Array { .. } => false,
+    };
+    if !direction_kind {
+        return Err(anyhow!(
+            "`{texture}` is a {}: direction lookups read one cube map or a lat-long map",
+            kind.describe()
+        ));
     }
-    let env = match (env, loaded.info.environment) {
-        (Some(e), _) => e,
-        (None, Some(Environment::LatLong)) => EnvArg::Latlong,
-        (None, Some(Environment::Cube)) => EnvArg::Cube,
-        (None, None) => {
-            return Err(anyhow!(
-                "`{texture}` records no environment (no OpenEXR envmap, no maketx \
-                 textureformat): say what it holds with --env latlong or --env cube"
-            ));
+    // --layer on a texture that is not an array is refused.
+    let picked = super::lookup::pick_image(texture, kind, layer)?;
+    // A file's own levels are kept, with its rounding and wrap modes.
+    let file = loaded.chain_options();
+    let hint = env.map(|e| match e {
+        EnvArg::Latlong => Environment::LatLong,
+        EnvArg::Cube => Environment::Cube,
+    });
+    let source = interpret(loaded, texture, hint)
+        .with_context(|| format!("cannot read texture `{texture}`"))?;
+    let own = |levels: Vec<Texture>, build: &dyn Fn(Texture) -> parvo::Result<MipChain>| {
+        let mut rest = levels.into_iter();
+        match (rest.next(), rest.len()) {
+            (Some(base), 0) => build(base),
+            (Some(base), _) => {
+                MipChain::from_levels(std::iter::once(base).chain(rest).collect(), file)
+            }
+            (None, _) => Err(parvo::Error::InvalidOption(
+                "an image without levels".into(),
+            )),
         }
     };
-    match env {
-        EnvArg::Latlong => {
-            // A file's own levels are kept; otherwise the levels are built
-            // as a lat-long map needs them (rows weighted by solid angle).
-            let chain = if loaded.levels.len() > 1 {
-                loaded
-                    .into_chain()
-                    .with_context(|| format!("cannot read texture `{texture}`"))?
-                    .0
-            } else {
-                latlong::build_chain(loaded.into_base())?
-            };
+    match source.kind {
+        ImageKind::LatLong => {
+            // Without levels of its own, the levels a lat-long map needs
+            // (rows weighted by solid angle).
+            let levels = source.images.into_iter().next().unwrap_or_default();
+            let chain = own(levels, &latlong::build_chain)?;
             Ok((
                 EnvSampler::LatLong(Box::new(LatLongSampler::new(&chain, options)?)),
                 channels,
             ))
         }
-        EnvArg::Cube => {
-            // The faces of level 0, each mip-mapped on its own (a strip's
-            // own levels would mix faces once they are 1 texel high). A
-            // file that records a cube map is OpenEXR's strip; otherwise
-            // the image's aspect tells the strip or cross.
-            let recorded = loaded.info.environment == Some(Environment::Cube);
-            let base = loaded.into_base();
-            let faces = if recorded {
-                faces_from_strip(&base)
+        ImageKind::Cube | ImageKind::CubeArray { .. } => {
+            // A KTX2 or DDS cube map (the cube --layer picks of an array)
+            // keeps its levels; faces cut from a strip or cross are each
+            // mip-mapped on their own (a strip's own levels would mix
+            // faces once they are 1 texel high).
+            let from_header = kind.is_cube();
+            let faces: Vec<Vec<Texture>> =
+                source.images.into_iter().skip(6 * picked).take(6).collect();
+            let chains = if from_header {
+                faces
+                    .into_iter()
+                    .map(|l| own(l, &|b| parvo::mip::build(b, &file)))
+                    .collect::<parvo::Result<Vec<_>>>()?
             } else {
-                faces_from_image(&base)
-            }
-            .with_context(|| format!("cannot read `{texture}` as a cube map"))?;
-            let chains = build_faces(faces, &MipOptions::default())?;
+                build_faces(
+                    faces.into_iter().map(|mut l| l.swap_remove(0)).collect(),
+                    &MipOptions::default(),
+                )?
+            };
             Ok((
                 EnvSampler::Cube(CubeSampler::new(&chains, options)?),
                 channels,
             ))
         }
+        _ => Err(anyhow!(
+            "`{texture}` records no environment (no OpenEXR envmap, no maketx \
+             textureformat): say what it holds with --env latlong or --env cube"
+        )),
     }
 }
 
@@ -151,7 +146,7 @@ pub fn run(
             }
         };
         text.clear();
-        super::sample::format_colour(&mut text, &s.sample(&q), channels);
+        super::lookup::format_colour(&mut text, &s.sample(&q), channels);
         match out.write_all(text.as_bytes()) {
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return Ok(()),
             r => r?,

@@ -6,7 +6,7 @@
 
 use std::process::ExitCode;
 
-use parvo::env::Kind;
+use parvo::ImageKind;
 use parvo::io::{self, Limits, Loaded};
 
 /// Arguments of `parvo info`.
@@ -35,7 +35,7 @@ pub struct InfoArgs {
     max_height: u32,
 
     /// Largest decoded size, e.g. 4G, 512M, 1000000.
-    #[arg(long, default_value = "4G", value_name = "BYTES", value_parser = super::mip::parse_bytes)]
+    #[arg(long, default_value = "4G", value_name = "BYTES", value_parser = super::args::parse_bytes)]
     max_alloc: u64,
 }
 
@@ -65,13 +65,13 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
             }
             Err(e) => {
                 failed = true;
-                eprintln!("parvo: {file}: {}", super::words(&e));
+                eprintln!("parvo: {file}: {}", super::words::words(&e));
                 if args.json {
                     // One object per file, failed ones included (as `mip
                     // --json` does), so a script sees every file.
                     println!(
                         "{}",
-                        serde_json::json!({"file": file, "status": "failed", "error": super::words(&e)})
+                        serde_json::json!({"file": file, "status": "failed", "error": super::words::words(&e)})
                     );
                 }
             }
@@ -150,7 +150,7 @@ fn text(file: &str, l: &Loaded) -> String {
             .unwrap_or_else(|| "(not recorded)".into())
     );
     for n in &i.notes {
-        let _ = writeln!(s, "  note:       {}", super::words(n));
+        let _ = writeln!(s, "  note:       {}", super::words::words(n));
     }
     if !i.attributes.is_empty() {
         let _ = writeln!(s, "  metadata:");
@@ -165,7 +165,7 @@ fn text(file: &str, l: &Loaded) -> String {
 /// or the environment the file records (OpenEXR, maketx).
 fn kind_text(i: &io::SourceInfo) -> String {
     match i.environment {
-        Some(io::Environment::LatLong) => Kind::LatLong.describe(),
+        Some(io::Environment::LatLong) => ImageKind::LatLong.describe(),
         Some(io::Environment::Cube) => {
             "cube map (OpenEXR strip: six faces stacked, +x -x +y -y +z -z from the top)".into()
         }
@@ -177,11 +177,11 @@ fn kind_text(i: &io::SourceInfo) -> String {
 /// `cube-array`, `latlong`.
 fn kind_id(i: &io::SourceInfo) -> &'static str {
     match (i.environment, i.kind) {
-        (Some(io::Environment::LatLong), _) | (None, Kind::LatLong) => "latlong",
-        (Some(io::Environment::Cube), _) | (None, Kind::Cube) => "cube",
-        (None, Kind::Array { .. }) => "array",
-        (None, Kind::CubeArray { .. }) => "cube-array",
-        (None, Kind::Plain) => "2d",
+        (Some(io::Environment::LatLong), _) | (None, ImageKind::LatLong) => "latlong",
+        (Some(io::Environment::Cube), _) | (None, ImageKind::Cube) => "cube",
+        (None, ImageKind::Array { .. }) => "array",
+        (None, ImageKind::CubeArray { .. }) => "cube-array",
+        (None, ImageKind::Plain) => "2d",
     }
 }
 
@@ -211,7 +211,7 @@ fn json(file: &str, l: &Loaded) -> String {
         })).collect::<Vec<_>>(),
         "wrapmodes": i.wrap.map(|w| format!("{},{}", w.u.oiio_name(), w.v.oiio_name())),
         "attributes": i.attributes.iter().cloned().collect::<std::collections::BTreeMap<_, _>>(),
-        "notes": i.notes.iter().map(super::words).collect::<Vec<_>>(),
+        "notes": i.notes.iter().map(super::words::words).collect::<Vec<_>>(),
     })
     .to_string()
 }

@@ -17,7 +17,7 @@ use std::time::Instant;
 use clap::ValueEnum;
 use indicatif::ProgressBar;
 
-use parvo::Wrap;
+use super::args::{ColorArg, QualityArg, parse_bytes};
 use parvo::compress::{BlockFormat, Quality};
 use parvo::io::exr::ExrCompression;
 use parvo::io::ktx2::Supercompression;
@@ -26,21 +26,10 @@ use parvo::mip::roughness::{NormalChannels, Specular};
 use parvo::mip::{MipFilter, NanPolicy, Rounding};
 use parvo::pipeline::{
     self, AlphaChoice, ColorChoice, Job, Note, Outcome, ResizeTo, RoughnessSettings,
-    RoughnessSource, Settings, Stage, Status, Usage,
+    RoughnessSource, Settings, Stage, Status,
 };
 use parvo::texel::ChannelType;
-
-/// How to interpret the colour channels of the input.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ColorArg {
-    /// What the file says: PNG by its sRGB/cICP/gAMA chunks (sRGB when it has none), JPEG sRGB,
-    /// KTX2 and DDS by their format, OpenEXR, TIFF and HDR linear.
-    Auto,
-    /// The input is linear light.
-    Linear,
-    /// The input is sRGB-encoded.
-    Srgb,
-}
+use parvo::{ImageKind, Wrap};
 
 /// Alpha convention of the input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -99,14 +88,6 @@ impl From<CompressArg> for BlockFormat {
             CompressArg::Bc6h => BlockFormat::Bc6h { signed: false },
         }
     }
-}
-
-/// `--quality` levels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum QualityArg {
-    Fast,
-    Normal,
-    Slow,
 }
 
 /// `--resize-to` rules.
@@ -438,27 +419,6 @@ fn parse_tile(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
-pub(crate) fn parse_bytes(s: &str) -> Result<u64, String> {
-    let t = s.trim();
-    let (num, mul) = match t.char_indices().last() {
-        Some((i, c)) if c.is_ascii_alphabetic() => {
-            let m: u64 = match c.to_ascii_uppercase() {
-                'K' => 1 << 10,
-                'M' => 1 << 20,
-                'G' => 1 << 30,
-                'T' => 1 << 40,
-                _ => return Err(format!("`{s}`: unknown unit (use K, M, G or T)")),
-            };
-            (&t[..i], m)
-        }
-        _ => (t, 1),
-    };
-    num.parse::<u64>()
-        .ok()
-        .and_then(|n| n.checked_mul(mul))
-        .ok_or_else(|| format!("`{s}` is not a byte count such as 4G or 512M"))
-}
-
 impl From<ColorArg> for ColorChoice {
     fn from(c: ColorArg) -> Self {
         match c {
@@ -531,6 +491,7 @@ fn settings(args: &MipArgs) -> Settings {
             ResizeArg::Pow2 => ResizeTo::Pow2,
         }),
         measure_blocks: args.stats || args.json,
+        env: Default::default(),
     }
 }
 
@@ -583,14 +544,6 @@ fn roughness_settings(args: &MipArgs) -> Result<Option<RoughnessSettings>, Strin
 }
 
 pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
-    if super::env_mip::wanted(&args.env, &args.inputs) {
-        return super::env_mip::run(
-            &args.inputs,
-            args.output.as_deref(),
-            &args.env,
-            &settings(&args),
-        );
-    }
     let (jobs, settings) = match jobs_and_settings(&args) {
         Ok(js) => js,
         Err(code) => return Ok(code),
@@ -598,18 +551,18 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     // Report panics (bugs in parvo or a dependency) as per-file errors, not
     // as the default multi-line message.
     std::panic::set_hook(Box::new(|_| {}));
-    super::remove_temporary_files_on_interrupt();
+    super::progress::remove_temporary_files_on_interrupt();
     let tty = std::io::stderr().is_terminal() && !args.json;
     let batch = jobs.len() > 1;
     let bar = if tty {
         let template = if batch {
-            super::BAR_FILES
+            super::progress::BAR_FILES
         } else {
-            super::BAR_PERCENT
+            super::progress::BAR_PERCENT
         };
         Some(
             ProgressBar::new(if batch { jobs.len() as u64 } else { 0 })
-                .with_style(super::bar_style(template)?),
+                .with_style(super::progress::bar_style(template)?),
         )
     } else {
         None
@@ -646,7 +599,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
 /// (said on stderr), found before any input is read.
 fn jobs_and_settings(args: &MipArgs) -> Result<(Vec<Job>, Settings), ExitCode> {
     let usage = |msg: String| {
-        eprintln!("parvo: {}", super::words(msg));
+        eprintln!("parvo: {}", super::words::words(msg));
         Err(ExitCode::from(2))
     };
     if let Some(n) = args.threads {
@@ -665,13 +618,21 @@ fn jobs_and_settings(args: &MipArgs) -> Result<(Vec<Job>, Settings), ExitCode> {
     };
     let jobs = match (&args.output, &args.out_dir) {
         (Some(out), None) => {
-            if inputs.len() != 1 {
+            // Six face files make one cube map.
+            let faces = inputs.len() == 6 && args.env.env.is_some();
+            if inputs.len() != 1 && !faces {
                 return usage(format!(
-                    "-o takes one input, got {}; use --out-dir DIR for a batch",
+                    "-o takes one input (or six face files +x -x +y -y +z -z with --env), \
+                     got {}; use --out-dir DIR for a batch",
                     inputs.len()
                 ));
             }
-            match Job::new(&inputs[0], out) {
+            let job = if faces {
+                Job::faces(&inputs, out)
+            } else {
+                Job::new(&inputs[0], out)
+            };
+            match job {
                 Ok(j) => vec![j],
                 Err(e) => return usage(e.to_string()),
             }
@@ -697,8 +658,12 @@ fn jobs_and_settings(args: &MipArgs) -> Result<(Vec<Job>, Settings), ExitCode> {
         Ok(r) => settings.roughness = r,
         Err(e) => return usage(e),
     }
+    match args.env.settings() {
+        Ok(e) => settings.env = e,
+        Err(e) => return usage(e),
+    }
     if let Err(e) = pipeline::check(&jobs, &settings) {
-        return usage(super::error_text(&e));
+        return usage(super::words::error_text(&e));
     }
     Ok((jobs, settings))
 }
@@ -742,8 +707,8 @@ impl Printer<'_> {
 
     fn warn(&self, s: String) {
         match self.bar {
-            Some(b) => b.suspend(|| eprintln!("{}", super::words(&s))),
-            None => eprintln!("{}", super::words(&s)),
+            Some(b) => b.suspend(|| eprintln!("{}", super::words::words(&s))),
+            None => eprintln!("{}", super::words::words(&s)),
         }
     }
 
@@ -774,7 +739,7 @@ impl Printer<'_> {
             }
             Err(e) => {
                 *self.failed.lock().unwrap_or_else(|e| e.into_inner()) += 1;
-                let msg = super::error_text(&e).replace('\n', " ");
+                let msg = super::words::error_text(&e).replace('\n', " ");
                 self.warn(format!("parvo: {}: {msg}", job.input));
                 if args.json {
                     self.line(
@@ -842,8 +807,12 @@ fn summary_line(job: &Job, o: &Outcome, args: &MipArgs, secs: f64) -> String {
         (None, Some(l)) => format!(", zlib {l}"),
         _ => String::new(),
     };
+    let kind = match o.image_kind {
+        ImageKind::Plain => String::new(),
+        k => format!("{} of ", k.describe()),
+    };
     format!(
-        "{} -> {out}: {}x{} {}{sc}, {} levels, {}{rough}{what}, {:.2} s",
+        "{} -> {out}: {kind}{}x{} {}{sc}, {} levels, {}{rough}{what}, {:.2} s",
         job.input,
         o.width,
         o.height,
@@ -896,6 +865,8 @@ fn json_line(job: &Job, o: &Outcome, secs: f64) -> String {
         "input": job.input,
         "output": o.output,
         "status": o.status.name(),
+        "kind": o.image_kind.id(),
+        "images": o.image_kind.images(),
         "width": o.width,
         "height": o.height,
         "channels": o.format.channels,
@@ -927,86 +898,12 @@ fn json_line(job: &Job, o: &Outcome, secs: f64) -> String {
             })).collect::<Vec<_>>(),
         })),
         "notes": o.notes.iter().map(note_text).collect::<Vec<_>>(),
+        "plan": {
+            "path": format!("{:?}", o.plan.path),
+            "memory_estimate_bytes": o.plan.memory_bytes,
+        },
     })
     .to_string()
-}
-
-/// A pipeline usage problem in this command's option names.
-pub(crate) fn usage_text(u: &Usage) -> String {
-    match u {
-        Usage::LevelsZero => "--levels must be at least 1".into(),
-        Usage::AlphaCoverageRange(r) => format!("--alpha-coverage {r}: must be between 0 and 1"),
-        Usage::TypeNotStored { ty: t, container } => format!(
-            "--type {t}: {container} cannot store {t} texels (EXR: f16, f32; PNG: u8, u16; KTX2 and DDS: all)"
-        ),
-        Usage::RoughnessNeedsNormalMap => {
-            "a roughness chain is made from a normal map: add --normal-map".into()
-        }
-        Usage::RoughnessOutputOfBatch => {
-            "--roughness-out names one file: use it with -o (one input)".into()
-        }
-        Usage::RoughnessPackedAndWritten => {
-            "--pack-roughness stores the roughness in the normal output: drop --roughness-out"
-                .into()
-        }
-        Usage::RoughnessNowhere => {
-            "give --roughness-out FILE or --pack-roughness A for the roughness".into()
-        }
-        Usage::RoughnessRange(a) => format!("--roughness {a}: must be from 0 to 1"),
-        Usage::CoverageOfNormalMap => "--alpha-coverage does not apply to normal maps".into(),
-        Usage::ExponentsNeedFloat => "--specular blinn-phong writes exponents above 1: the chain \
-                                      needs a float output (.exr, or --type f16/f32 with \
-                                      .ktx2/.dds)"
-            .into(),
-        Usage::EncodersMissing(bf) => format!(
-            "--compress {}: this parvo was built without the `encode` feature (the block encoders)",
-            bf.name().to_ascii_lowercase()
-        ),
-        Usage::BlocksNotStored { container, output } => format!(
-            "--compress: {container} cannot store block-compressed texels; use .ktx2 or .dds \
-             (output {})",
-            output.display()
-        ),
-        Usage::TypeWithBlocks(t) => {
-            format!("--type {t} with --compress: the block format fixes what is stored")
-        }
-        Usage::BlocksWithRoughness => "--compress with --roughness is not supported yet: \
-                                       compress the normal and roughness chains in two runs"
-            .into(),
-        Usage::SupercompressionLevel { scheme, lo, hi } => format!(
-            "--{} {}: the level must be from {lo} to {hi}",
-            scheme.name(),
-            match scheme {
-                Supercompression::Zstd(l) | Supercompression::Zlib(l) => l,
-            }
-        ),
-        Usage::SupercompressionNotStored {
-            scheme,
-            output,
-            container,
-        } => format!(
-            "--{}: supercompression is a KTX2 feature; output {} is {container}",
-            scheme.name(),
-            output.display()
-        ),
-        Usage::ResizeNormalMap => {
-            "--resize-to with --normal-map is not supported: resize the normal map first".into()
-        }
-        Usage::RoundingUpNotStored { container, output } => format!(
-            "--rounding up: {container} defines its level sizes as floor(size / 2^k); use .exr \
-             or PNG levels for rounded-up chains (output {})",
-            output.display()
-        ),
-        Usage::PackOverwritesAlpha => "the normal map has a fourth channel; --pack-roughness \
-                                       would overwrite it (write the roughness with \
-                                       --roughness-out instead)"
-            .into(),
-        Usage::ExrLevels { full } => format!(
-            "a mip-mapped OpenEXR file holds the full chain ({full} levels); --levels applies to \
-             .ktx2, .dds and PNG"
-        ),
-        _ => u.to_string(),
-    }
 }
 
 /// A pipeline note in this command's option names.
@@ -1031,7 +928,7 @@ fn note_text(n: &Note) -> String {
              the {to} range; keep a float output (.exr, or --type f16) to keep them"
         ),
         // The loader's notes, which may name settings.
-        _ => super::words(n),
+        _ => super::words::words(n),
     }
 }
 

@@ -124,7 +124,7 @@ fn shade(args: &RenderArgs, brdf: ShadeBrdf) -> Result<ExitCode> {
     ) {
         Ok(i) => i,
         Err(e @ parvo::Error::InvalidOption(_)) => {
-            eprintln!("parvo: {}", super::words(&e));
+            eprintln!("parvo: {}", super::words::words(&e));
             return Ok(ExitCode::from(2));
         }
         Err(e) => return Err(e.into()),

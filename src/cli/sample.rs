@@ -17,9 +17,10 @@ use std::io::{self, BufRead, BufWriter, Write};
 use std::path::Path;
 use std::process::ExitCode;
 
+use super::lookup::{format_colour, pick_image};
 use anyhow::{Context, Result, anyhow};
+use parvo::ImageKind;
 use parvo::Wrap;
-use parvo::env::{Kind, layer_index};
 use parvo::sample::{CompareOp, Filter, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
 
 /// Queries parsed and sampled per batch.
@@ -157,7 +158,7 @@ pub struct SampleArgs {
         and -y below +z) or a vertical cross 3w x 4w (-x +z +x across, +y above +z, -y below it, \
         -z below -y turned 180 degrees); each face mip-mapped on its own."
     )]
-    env: Option<super::env::EnvArg>,
+    env: Option<super::args::EnvArg>,
     /// Array layer to sample (2-D arrays), or cube (cube-map arrays, with --direction); GL rounds it.
     #[arg(
         long,
@@ -252,7 +253,7 @@ impl SampleArgs {
 pub fn run(args: SampleArgs) -> Result<ExitCode> {
     let mut options = args.options();
     if let Err(e) = options.validate() {
-        eprintln!("parvo: {}", super::words(&e));
+        eprintln!("parvo: {}", super::words::words(&e));
         return Ok(ExitCode::from(2));
     }
     if args.direction {
@@ -274,7 +275,7 @@ pub fn run(args: SampleArgs) -> Result<ExitCode> {
     let chain = if args.layer.is_some()
         || matches!(
             parvo::io::peek_kind(Path::new(&args.texture)),
-            Kind::Array { .. }
+            ImageKind::Array { .. }
         ) {
         let loaded = args.read.load_environment(&args.texture)?;
         let kind = loaded.info.kind;
@@ -312,50 +313,6 @@ pub fn run(args: SampleArgs) -> Result<ExitCode> {
         Err(e) if is_broken_pipe(&e) => Ok(ExitCode::SUCCESS),
         Err(e) => Err(e),
         Ok(()) => Ok(ExitCode::SUCCESS),
-    }
-}
-
-/// The image `--layer` picks in `spec`, a texture of `kind`: for a 2-D
-/// array the layer, for a cube-map array the cube, as GL rounds an array
-/// coordinate ([`parvo::env::layer_index`]); 0 for one image. An array of
-/// more than one layer or cube without `--layer`, and `--layer` on a
-/// texture that is not an array, are refused saying why.
-pub(super) fn pick_image(spec: &str, kind: Kind, layer: Option<f32>) -> Result<usize> {
-    let (count, noun, what) = match kind {
-        Kind::Array { layers } => (
-            layers as usize,
-            "layer",
-            format!("a 2-D array of {layers} layers"),
-        ),
-        Kind::CubeArray { cubes } => (
-            cubes as usize,
-            "cube",
-            format!("a cube-map array of {cubes} cubes"),
-        ),
-        _ => {
-            let what = match kind {
-                Kind::Plain => "one 2-D image".to_string(),
-                Kind::Cube => "one cube map".to_string(),
-                Kind::LatLong => "a lat-long environment map".to_string(),
-                other => other.describe(),
-            };
-            return match layer {
-                None => Ok(0),
-                Some(_) => Err(anyhow!(
-                    "--layer picks a layer of a 2-D array (or, with --direction, a cube of a \
-                     cube-map array), and `{spec}` is {what}, not an array"
-                )),
-            };
-        }
-    };
-    match layer {
-        Some(l) => Ok(layer_index(l, count)),
-        None if count <= 1 => Ok(0),
-        None => Err(anyhow!(
-            "`{spec}` is {what}: say which {noun} to sample with --layer N, N from 0 to {} \
-             (rounded as GL rounds an array layer, clamped to that range)",
-            count - 1
-        )),
     }
 }
 
@@ -456,24 +413,6 @@ fn stream(
             return Ok(());
         }
     }
-}
-
-/// One line of output: the texture's channels of an RGBA colour.
-pub(super) fn format_colour(s: &mut String, c: &[f32; 4], channels: usize) {
-    use std::fmt::Write as _;
-    let vals: &[f32] = match channels {
-        1 => &c[..1],
-        2 => &[c[0], c[3]],
-        3 => &c[..3],
-        _ => &c[..],
-    };
-    for (i, v) in vals.iter().enumerate() {
-        if i > 0 {
-            s.push(' ');
-        }
-        let _ = write!(s, "{v}");
-    }
-    s.push('\n');
 }
 
 /// Parse one input line of `columns` numbers (6, or 7 with the reference

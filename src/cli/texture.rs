@@ -12,7 +12,7 @@ use parvo::mip::NanPolicy;
 use parvo::scene::Scene;
 use parvo::texel::ColorSpace;
 
-use super::mip::ColorArg;
+use super::args::ColorArg;
 
 /// How to read the texture file.
 #[derive(clap::Args, Debug, Clone)]
@@ -103,13 +103,13 @@ impl TextureArgs {
 
     fn load_as(&self, spec: &str, options: LoadOptions) -> Result<Loaded> {
         let loaded = io::load_with(spec, &Limits::default(), &options)
-            .map_err(super::with_hint)
+            .map_err(super::words::with_hint)
             .with_context(|| format!("cannot read texture `{spec}`"))?;
         let assumed = (self.color == ColorArg::Auto)
             .then(|| io::assumed_color_note(&loaded.info, &loaded.base().format()))
             .flatten();
         for n in loaded.info.notes.iter().chain(&assumed) {
-            eprintln!("parvo: {spec}: {}", super::words(n));
+            eprintln!("parvo: {spec}: {}", super::words::words(n));
         }
         Ok(loaded)
     }

@@ -101,7 +101,7 @@ pub struct TradeoffArgs {
         value_name = "Q",
         requires = "compress"
     )]
-    quality: super::mip::QualityArg,
+    quality: super::args::QualityArg,
 }
 
 fn machine() -> serde_json::Value {
@@ -165,9 +165,9 @@ fn settings(args: &TradeoffArgs) -> std::result::Result<Settings, String> {
     settings.flicker_shift = FLICKER_SHIFT;
     settings.compress = args.compress.map(|c| {
         let quality = match args.quality {
-            super::mip::QualityArg::Fast => Quality::Fast,
-            super::mip::QualityArg::Normal => Quality::Normal,
-            super::mip::QualityArg::Slow => Quality::Slow,
+            super::args::QualityArg::Fast => Quality::Fast,
+            super::args::QualityArg::Normal => Quality::Normal,
+            super::args::QualityArg::Slow => Quality::Slow,
         };
         (BlockFormat::from(c), quality)
     });
@@ -217,7 +217,7 @@ pub fn run(args: TradeoffArgs) -> Result<ExitCode> {
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let bar = if std::io::stderr().is_terminal() {
         let b = ProgressBar::new(tradeoff::progress_total(&settings));
-        b.set_style(super::bar_style(super::BAR_COUNT)?);
+        b.set_style(super::progress::bar_style(super::progress::BAR_COUNT)?);
         Some(b)
     } else {
         None

@@ -1,7 +1,7 @@
 //! Environment maps, cube maps and texture arrays: textures looked up by
 //! a direction (or a layer index) instead of a 2-D coordinate.
 //!
-//! - [`Kind`]: what a file's image is — a 2-D texture, an array of them, a
+//! - [`crate::ImageKind`]: what a file's image is — a 2-D texture, an array of them, a
 //!   cube map, an array of cube maps, or a 2-D image that is a lat-long
 //!   environment.
 //! - [`cube`]: face selection, face coordinates and their derivatives as
@@ -32,58 +32,6 @@ pub use latlong::LatLongSampler;
 use crate::error::{Error, Result};
 use crate::mip::MipChain;
 use crate::sample::{Query, Sampler, SamplerOptions};
-
-/// What kind of image a texture is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
-pub enum Kind {
-    /// One 2-D image (with its mip levels).
-    #[default]
-    Plain,
-    /// `layers` 2-D images of one size and format.
-    Array {
-        /// Layer count (at least 1).
-        layers: u32,
-    },
-    /// Six square faces, in the order +X, −X, +Y, −Y, +Z, −Z.
-    Cube,
-    /// `cubes` cube maps (6 × `cubes` faces, cube by cube).
-    CubeArray {
-        /// Cube count (at least 1).
-        cubes: u32,
-    },
-    /// A 2-D image holding the sphere of directions in latitude and
-    /// longitude (equirectangular), OpenImageIO's `LatLong Environment`.
-    LatLong,
-}
-
-impl Kind {
-    /// How many 2-D images (faces or layers, each with its own mip chain)
-    /// a texture of this kind holds.
-    pub fn images(self) -> usize {
-        match self {
-            Kind::Plain | Kind::LatLong => 1,
-            Kind::Array { layers } => layers as usize,
-            Kind::Cube => 6,
-            Kind::CubeArray { cubes } => 6 * cubes as usize,
-        }
-    }
-
-    /// True for a cube map or an array of them.
-    pub fn is_cube(self) -> bool {
-        matches!(self, Kind::Cube | Kind::CubeArray { .. })
-    }
-
-    /// A short description, as `parvo info` prints it.
-    pub fn describe(self) -> String {
-        match self {
-            Kind::Plain => "2-D".into(),
-            Kind::Array { layers } => format!("2-D array, {layers} layers"),
-            Kind::Cube => "cube map (+x -x +y -y +z -z)".into(),
-            Kind::CubeArray { cubes } => format!("cube map array, {cubes} cubes"),
-            Kind::LatLong => "lat-long environment".into(),
-        }
-    }
-}
 
 /// A lookup by direction: the direction (any non-zero length) and its
 /// change per pixel along screen x (`ddx`) and y (`ddy`), as a shader

@@ -18,10 +18,10 @@ use std::path::{Path, PathBuf};
 
 use super::{CONTAINERS, Limits, LoadOptions, Loaded, Overlap, SaveOptions};
 use crate::compress::BlockChain;
-use crate::env::Kind;
 use crate::error::{Error, Result};
 use crate::mip::Rounding;
 use crate::texel::{AlphaMode, ChannelType, Format};
+use crate::texture::ImageKind;
 use crate::texture::Texture;
 
 /// What an output container can hold and how it names its files.
@@ -116,6 +116,13 @@ pub trait Container: Send + Sync {
             ),
         })
     }
+    /// The kind of image a file of this container holds (a cube map, an
+    /// array, a recorded environment), from its first bytes `head` (up to
+    /// 148) or its headers at `path`; `None` when it cannot tell or holds
+    /// one 2-D image ([`super::peek_kind`]).
+    fn peek_kind(&self, _head: &[u8], _path: &Path) -> Option<ImageKind> {
+        None
+    }
     /// File extensions (lower case) of the files it reads, for inputs
     /// given as a directory.
     fn read_extensions(&self) -> &'static [&'static str] {
@@ -157,19 +164,30 @@ pub trait Container: Send + Sync {
     fn storable(&self, f: Format) -> Format {
         f
     }
-    /// Write `levels` (level 0 first, sizes following `rounding`) to
-    /// `path` atomically. Called by [`save`] after the common checks.
+    /// Write an image of `kind` to `path` atomically: `images` holds each
+    /// face or layer's levels (level 0 first, sizes following `rounding`,
+    /// in [`super::Loaded::images`]'s order), one entry for a 2-D or
+    /// lat-long image. Called by [`save_images`] after the common checks,
+    /// only for a `kind` the container [`Container::holds`].
     fn save(
         &self,
-        _levels: &[Texture],
+        _images: &[&[Texture]],
+        _kind: ImageKind,
         _rounding: Rounding,
         path: &Path,
         _options: &SaveOptions,
     ) -> Result<()> {
         Err(not_writable(self.name(), path))
     }
-    /// Write a block-compressed chain to `path` atomically.
-    fn save_blocks(&self, _chain: &BlockChain, _path: &Path, _options: &SaveOptions) -> Result<()> {
+    /// Write block-compressed chains (one per face or layer, as in
+    /// [`Container::save`]) of an image of `kind` to `path` atomically.
+    fn save_blocks(
+        &self,
+        _chains: &[BlockChain],
+        _kind: ImageKind,
+        _path: &Path,
+        _options: &SaveOptions,
+    ) -> Result<()> {
         Err(Error::InvalidOption(format!(
             "{} cannot store block-compressed texels: use {}",
             self.name(),
@@ -181,28 +199,13 @@ pub trait Container: Send + Sync {
         None
     }
     /// True when the container can write an image of `kind` (every
-    /// output writes [`Kind::Plain`]).
-    fn holds(&self, kind: Kind) -> bool {
-        kind == Kind::Plain
-    }
-    /// Write the faces or layers of a cube map or an array (`images`,
-    /// each its levels, in [`super::Loaded::images`]'s order) or a
-    /// lat-long map to `path` atomically. Called by [`save_images`] after
-    /// the common checks, only for a `kind` the container
-    /// [`Container::holds`].
-    fn save_images(
-        &self,
-        _images: &[&[Texture]],
-        kind: Kind,
-        _rounding: Rounding,
-        path: &Path,
-        _options: &SaveOptions,
-    ) -> Result<()> {
-        Err(cannot_hold(self.name(), kind, path))
+    /// output writes [`ImageKind::Plain`]).
+    fn holds(&self, kind: ImageKind) -> bool {
+        kind == ImageKind::Plain
     }
 }
 
-fn cannot_hold(name: &str, kind: Kind, path: &Path) -> Error {
+fn cannot_hold(name: &str, kind: ImageKind, path: &Path) -> Error {
     let holders: Vec<String> = outputs()
         .filter(|k| k.holds(kind))
         .map(|k| format!(".{}", k.id()))
@@ -251,6 +254,33 @@ pub fn outputs() -> impl Iterator<Item = OutputKind> {
         .copied()
         .filter(|c| c.stores().is_some())
         .map(OutputKind)
+}
+
+/// What channel types each output container stores, from the table:
+/// `OpenEXR: f16, f32; KTX2: all; ...` (for messages).
+pub fn types_stored() -> String {
+    let all = [
+        ChannelType::U8,
+        ChannelType::U16,
+        ChannelType::F16,
+        ChannelType::F32,
+    ];
+    outputs()
+        .map(|k| {
+            let types: Vec<String> = all
+                .iter()
+                .filter(|t| k.supports(**t))
+                .map(|t| t.to_string())
+                .collect();
+            let list = if types.len() == all.len() {
+                "all".to_string()
+            } else {
+                types.join(", ")
+            };
+            format!("{}: {list}", k.name())
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// `a`, `a or b`, `a, b, or c`.
@@ -396,7 +426,7 @@ impl fmt::Debug for OutputKind {
 }
 
 /// Write `levels` (level 0 first, sizes following `rounding`) to `path`
-/// atomically in the container `kind`.
+/// atomically in the container `kind`: one 2-D image ([`save_images`]).
 pub fn save(
     levels: &[Texture],
     rounding: Rounding,
@@ -404,17 +434,7 @@ pub fn save(
     kind: OutputKind,
     options: &SaveOptions,
 ) -> Result<()> {
-    let first = levels
-        .first()
-        .ok_or_else(|| Error::InvalidOption("nothing to write: no levels".into()))?;
-    if !kind.supports(first.channel_type()) {
-        return Err(Error::InvalidOption(format!(
-            "{kind:?} output cannot store {} texels",
-            first.channel_type()
-        )));
-    }
-    check_levels(levels, rounding)?;
-    kind.0.save(levels, rounding, path, options)
+    save_images(&[levels], ImageKind::Plain, rounding, path, kind, options)
 }
 
 /// Write a texture of image kind `image_kind` to `path` atomically in the
@@ -424,7 +444,7 @@ pub fn save(
 /// image.
 pub fn save_images(
     images: &[&[Texture]],
-    image_kind: Kind,
+    image_kind: ImageKind,
     rounding: Rounding,
     path: &Path,
     kind: OutputKind,
@@ -468,8 +488,47 @@ pub fn save_images(
             first[0].height()
         )));
     }
-    kind.0
-        .save_images(images, image_kind, rounding, path, options)
+    kind.0.save(images, image_kind, rounding, path, options)
+}
+
+/// Write block-compressed chains of an image of kind `image_kind` (one
+/// chain per face or layer, all of one format, size and level count) to
+/// `path` atomically in the container `kind`.
+pub fn save_blocks(
+    chains: &[BlockChain],
+    image_kind: ImageKind,
+    path: &Path,
+    kind: OutputKind,
+    options: &SaveOptions,
+) -> Result<()> {
+    if !kind.holds(image_kind) {
+        return Err(cannot_hold(kind.name(), image_kind, path));
+    }
+    if chains.len() != image_kind.images() {
+        return Err(Error::InvalidOption(format!(
+            "a {} holds {} images, got {}",
+            image_kind.describe(),
+            image_kind.images(),
+            chains.len()
+        )));
+    }
+    for (i, c) in chains.iter().enumerate() {
+        c.validate()?;
+        let shape = |c: &BlockChain| (c.format, c.srgb, c.alpha, c.width, c.height, c.levels.len());
+        if shape(c) != shape(&chains[0]) {
+            return Err(Error::InvalidOption(format!(
+                "image {i} of the {} differs from the first in size, format or level count",
+                image_kind.describe()
+            )));
+        }
+    }
+    if image_kind.is_cube() && chains[0].width != chains[0].height {
+        return Err(Error::InvalidOption(format!(
+            "a cube map's faces must be square, got {}x{}",
+            chains[0].width, chains[0].height
+        )));
+    }
+    kind.0.save_blocks(chains, image_kind, path, options)
 }
 
 /// Every level of `levels` the size `rounding` gives and the format of

@@ -25,14 +25,12 @@ mod image_errors;
 pub mod ktx2;
 pub mod limits;
 pub mod png_levels;
+pub mod source;
 pub mod tiff;
 
-use std::borrow::Cow;
 use std::fmt;
 use std::io::Read;
 use std::path::Path;
-
-use half::slice::HalfFloatSliceExt;
 
 use crate::error::{Error, Result};
 use crate::mip::{self, MipChain, MipOptions, NanPolicy, Rounding};
@@ -41,7 +39,8 @@ use crate::texel::{ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::Wrap;
 
-pub use container::{Container, OutputKind, Stores, save, save_images};
+pub use crate::texel::{le_bytes, texels_from_le};
+pub use container::{Container, OutputKind, Stores, save, save_blocks, save_images};
 
 /// The container table ([`container`]): every container, in detection
 /// order; the last reads whatever no other claims. A new container is a
@@ -140,7 +139,7 @@ pub struct SourceInfo {
     /// [`LoadOptions::environment`] lets them read such files (see
     /// [`EnvironmentMaps`]); a lat-long OpenEXR stays `Plain` here and is
     /// told by [`SourceInfo::environment`].
-    pub kind: crate::env::Kind,
+    pub kind: crate::texture::ImageKind,
 }
 
 impl SourceInfo {
@@ -157,7 +156,7 @@ impl SourceInfo {
             blocks: None,
             color_stated: true,
             environment: None,
-            kind: crate::env::Kind::Plain,
+            kind: crate::texture::ImageKind::Plain,
         }
     }
 
@@ -420,17 +419,17 @@ pub(crate) fn environment_map(
 /// image it would lose every face or layer but the first.
 pub(crate) fn layered_image(
     format: &'static str,
-    kind: crate::env::Kind,
+    kind: crate::texture::ImageKind,
     (w, h): (u32, u32),
     options: &LoadOptions,
 ) -> Result<()> {
     let what = match kind {
-        crate::env::Kind::Cube => format!("a cube map of six {w}x{h} faces"),
-        crate::env::Kind::CubeArray { cubes } => {
+        crate::texture::ImageKind::Cube => format!("a cube map of six {w}x{h} faces"),
+        crate::texture::ImageKind::CubeArray { cubes } => {
             format!("an array of {cubes} cube maps ({w}x{h} faces)")
         }
         // One layer is all of a one-layer array.
-        crate::env::Kind::Array { layers } if layers > 1 => {
+        crate::texture::ImageKind::Array { layers } if layers > 1 => {
             format!("a 2-D array of {layers} {w}x{h} layers")
         }
         _ => return Ok(()),
@@ -503,9 +502,9 @@ impl Default for LoadOptions {
 }
 
 /// The kind of image the file at `path` holds (a cube map, an array),
-/// from its first bytes only; [`crate::env::Kind::Plain`] for every file
+/// from its first bytes only; [`crate::texture::ImageKind::Plain`] for every file
 /// that is neither or cannot be read (the load says why).
-pub fn peek_kind(path: &Path) -> crate::env::Kind {
+pub fn peek_kind(path: &Path) -> crate::texture::ImageKind {
     let mut head = [0u8; 148];
     let n = std::fs::File::open(path)
         .and_then(|mut f| {
@@ -520,17 +519,9 @@ pub fn peek_kind(path: &Path) -> crate::env::Kind {
         })
         .unwrap_or(0);
     let head = &head[..n];
-    if ktx2::Ktx2.detect(head) {
-        ktx2::peek_kind(head)
-    } else if dds::Dds.detect(head) {
-        dds::peek_kind(head)
-    } else if exr::OpenExr.detect(head) {
-        exr::peek_kind(path)
-    } else if tiff::Tiff.detect(head) {
-        tiff::peek_kind(path)
-    } else {
-        crate::env::Kind::Plain
-    }
+    container::detect(head)
+        .and_then(|c| c.peek_kind(head, path))
+        .unwrap_or(crate::texture::ImageKind::Plain)
 }
 
 /// Load a texture file or a `builtin:` name (see the module docs).
@@ -760,55 +751,6 @@ pub fn orient(t: &Texture, code: u16) -> Result<Texture> {
     Texture::from_texels(ow as u32, oh as u32, t.format(), texels)
 }
 
-/// The stored values as little-endian bytes (borrowed on little-endian
-/// machines).
-pub fn le_bytes(texels: &Texels) -> Cow<'_, [u8]> {
-    #[cfg(target_endian = "little")]
-    {
-        match texels {
-            Texels::U8(v) => Cow::Borrowed(v.as_slice()),
-            Texels::U16(v) => Cow::Borrowed(bytemuck::cast_slice(v)),
-            Texels::F16(v) => Cow::Borrowed(bytemuck::cast_slice(v.reinterpret_cast())),
-            Texels::F32(v) => Cow::Borrowed(bytemuck::cast_slice(v)),
-        }
-    }
-    #[cfg(not(target_endian = "little"))]
-    {
-        match texels {
-            Texels::U8(v) => Cow::Borrowed(v.as_slice()),
-            Texels::U16(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-            Texels::F16(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-            Texels::F32(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-        }
-    }
-}
-
-/// Texels of the given type from little-endian bytes (length must be a
-/// multiple of the type's size).
-pub fn texels_from_le(ty: ChannelType, bytes: &[u8]) -> Texels {
-    match ty {
-        ChannelType::U8 => Texels::U8(bytes.to_vec()),
-        ChannelType::U16 => Texels::U16(
-            bytes
-                .chunks_exact(2)
-                .map(|b| u16::from_le_bytes([b[0], b[1]]))
-                .collect(),
-        ),
-        ChannelType::F16 => Texels::F16(
-            bytes
-                .chunks_exact(2)
-                .map(|b| half::f16::from_le_bytes([b[0], b[1]]))
-                .collect(),
-        ),
-        ChannelType::F32 => Texels::F32(
-            bytes
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                .collect(),
-        ),
-    }
-}
-
 /// The fingerprint `--update` compares: a 128-bit XXH3 hash of level 0's
 /// format, size and texel bytes and of `options` (every setting that changes
 /// the output), as 32 hex digits.
@@ -860,18 +802,6 @@ impl Default for SaveOptions {
             supercompression: None,
         }
     }
-}
-
-/// Write a block-compressed chain to `path` atomically in a container
-/// that stores blocks (KTX2 with `options`' key/value data and
-/// supercompression, DDS with a DX10 header).
-pub fn save_blocks(
-    chain: &crate::compress::BlockChain,
-    path: &Path,
-    kind: OutputKind,
-    options: &SaveOptions,
-) -> Result<()> {
-    kind.save_blocks(chain, path, options)
 }
 
 /// The fingerprint stored in an existing output (EXR attribute or KTX2

@@ -174,11 +174,12 @@ impl super::Container for PngLevels {
     }
     fn save(
         &self,
-        levels: &[Texture],
+        images: &[&[Texture]],
+        _kind: crate::texture::ImageKind,
         _rounding: crate::mip::Rounding,
         path: &Path,
         _options: &super::SaveOptions,
     ) -> Result<()> {
-        save(levels, path)
+        save(images[0], path)
     }
 }

@@ -678,19 +678,19 @@ fn environment(texture_format: Option<&str>) -> Option<Environment> {
 }
 
 /// The environment kind a TIFF's first directory declares with maketx's
-/// `textureformat` tag: [`crate::env::Kind::LatLong`] for `LatLong
+/// `textureformat` tag: [`crate::texture::ImageKind::LatLong`] for `LatLong
 /// Environment`, else `Plain` (also for a file that does not read). A
 /// `CubeFace Environment` stays `Plain`: maketx lays its faces out 3x2,
 /// which parvo does not build from, and the load refuses it in words.
-pub(crate) fn peek_kind(path: &Path) -> crate::env::Kind {
+pub(crate) fn peek_kind(path: &Path) -> crate::texture::ImageKind {
     let read = || {
         let file = File::open(path).ok()?;
         let mut d = Decoder::new(BufReader::new(file)).ok()?;
         ascii_tag(&mut d, Tag::Unknown(tag::TEXTURE_FORMAT))
     };
     match std::panic::catch_unwind(read).ok().flatten().as_deref() {
-        Some("LatLong Environment") => crate::env::Kind::LatLong,
-        _ => crate::env::Kind::Plain,
+        Some("LatLong Environment") => crate::texture::ImageKind::LatLong,
+        _ => crate::texture::ImageKind::Plain,
     }
 }
 
@@ -927,6 +927,9 @@ fn apply_orientation(
 pub struct Tiff;
 
 impl super::Container for Tiff {
+    fn peek_kind(&self, _head: &[u8], path: &Path) -> Option<crate::texture::ImageKind> {
+        Some(peek_kind(path))
+    }
     fn id(&self) -> &'static str {
         "tiff"
     }

@@ -450,7 +450,7 @@ fn encode_band(
     if !direct {
         let t = Texture::from_f32(lw as u32, lr as u32, fmt, lin.to_vec())?;
         let t = convert_level(associate(t, association)?, out)?;
-        dst.copy_from_slice(&crate::io::le_bytes(t.texels()));
+        dst.copy_from_slice(&crate::texel::le_bytes(t.texels()));
         return Ok(());
     }
     const STEP: usize = 256;
@@ -811,12 +811,25 @@ pub(crate) fn build_converted(
     // Float data (HDR) written to a normalised type is clipped to [0, 1]:
     // count the texels that lose something, to say so once.
     let count_clipped = src.channel_type.is_float() && !out_format.channel_type.is_float();
+    finish_levels(chain.into_levels(), association, out_format, count_clipped)
+}
+
+/// Levels built unrounded (a source-format chain, or linear f32) stored as
+/// `out_format`: each level's alpha association changed (f32 levels) and
+/// converted once, smallest level first, so that level 0's f32 and
+/// converted copies never coexist with the unconverted rest of the
+/// chain; with `count_clipped`, the texels clipped to a normalised
+/// type's range counted.
+pub(crate) fn finish_levels(
+    built: Vec<Texture>,
+    association: Option<AlphaMode>,
+    out_format: Format,
+    count_clipped: bool,
+) -> Result<(Vec<Texture>, Option<Clipped>)> {
     let mut clipped = 0u64;
     let mut texels = 0u64;
-    // Smallest level first, so level 0's f32 and converted copies never
-    // coexist with the unconverted rest of the chain.
-    let mut levels: Vec<Texture> = Vec::with_capacity(chain.len());
-    for l in chain.into_levels().into_iter().rev() {
+    let mut levels: Vec<Texture> = Vec::with_capacity(built.len());
+    for l in built.into_iter().rev() {
         let l = associate(l, association)?;
         if count_clipped {
             clipped += outside_unit_range(&l);

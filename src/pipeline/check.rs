@@ -9,11 +9,13 @@ use std::path::PathBuf;
 use super::{Job, RoughnessSettings, RoughnessSource, Settings};
 use crate::compress::BlockFormat;
 use crate::error::{Error, Result};
-use crate::io::OutputKind;
 use crate::io::ktx2::Supercompression;
+use crate::io::{Environment, OutputKind};
 use crate::mip::Rounding;
 use crate::mip::roughness::Specular;
+use crate::setting::Setting;
 use crate::texel::ChannelType;
+use crate::texture::ImageKind;
 
 /// A setting that does not fit the job or another setting
 /// ([`Error::Usage`]). Each says which setting, which value and which
@@ -95,6 +97,37 @@ pub enum Usage {
         /// The full chain's level count.
         full: u32,
     },
+    /// A setting that does not apply to an image of this kind.
+    NotForKind {
+        /// The setting.
+        setting: Setting,
+        /// The image kind being built.
+        kind: ImageKind,
+        /// Why, in a few words.
+        why: &'static str,
+    },
+    /// An image kind the output container cannot store.
+    KindNotStored {
+        /// The image kind being built.
+        kind: ImageKind,
+        /// The container's name.
+        container: &'static str,
+        /// The containers that store it (`.exr`, `.ktx2`, ...).
+        holders: Vec<String>,
+    },
+    /// An image that cannot become the environment asked for.
+    NotAnEnvironment {
+        /// What the input holds.
+        kind: ImageKind,
+        /// The environment asked for.
+        target: Environment,
+    },
+    /// Prefiltered levels of anything but a cube map.
+    PrefilterNeedsCube,
+    /// An irradiance output of an input that is no environment.
+    IrradianceNeedsEnvironment,
+    /// An irradiance output (one file) with more than one job.
+    IrradianceOfBatch,
 }
 
 impl fmt::Display for Usage {
@@ -106,7 +139,8 @@ impl fmt::Display for Usage {
             }
             Usage::TypeNotStored { ty, container } => write!(
                 f,
-                "{container} cannot store {ty} texels (EXR: f16, f32; PNG: u8, u16; KTX2 and DDS: all)"
+                "{container} cannot store {ty} texels ({})",
+                crate::io::container::types_stored()
             ),
             Usage::RoughnessNeedsNormalMap => {
                 write!(f, "a roughness chain is made from a normal map")
@@ -189,6 +223,79 @@ impl fmt::Display for Usage {
                 "a mip-mapped OpenEXR file holds the full chain ({full} levels); a level count \
                  applies to KTX2, DDS and PNG"
             ),
+            _ => self.fmt_kinds(f),
+        }
+    }
+}
+
+impl Usage {
+    /// The words of the problems with an image's kind.
+    fn fmt_kinds(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Usage::NotForKind { setting, kind, why } => write!(
+                f,
+                "{setting} does not apply to a {}: {why}",
+                kind.describe()
+            ),
+            Usage::KindNotStored {
+                kind,
+                container,
+                holders,
+            } => write!(
+                f,
+                "{container} cannot store a {}{}",
+                kind.describe(),
+                if holders.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (use {})", holders.join(" or "))
+                }
+            ),
+            Usage::NotAnEnvironment { kind, target } => write!(
+                f,
+                "a {} cannot become a {target} environment map{}",
+                kind.describe(),
+                match target {
+                    Environment::LatLong => " (one cube map can)",
+                    Environment::Cube => " (a lat-long map or six faces can)",
+                }
+            ),
+            Usage::PrefilterNeedsCube => write!(
+                f,
+                "{} builds a cube map: set {} to a cube map",
+                Setting::Prefilter,
+                Setting::Environment
+            ),
+            Usage::IrradianceNeedsEnvironment => write!(
+                f,
+                "{} needs an environment map (a cube map or a lat-long map; see {})",
+                Setting::Irradiance,
+                Setting::Environment
+            ),
+            Usage::IrradianceOfBatch => write!(
+                f,
+                "{} names one file: use it with one input",
+                Setting::Irradiance
+            ),
+            _ => Ok(()),
+        }
+    }
+}
+
+impl std::error::Error for Usage {}
+
+impl From<Usage> for Error {
+    fn from(u: Usage) -> Error {
+        Error::Usage(Box::new(u))
+    }
+}
+
+impl Usage {
+    /// The usage problem `e` is, if it is one ([`Error::Usage`]).
+    pub fn of(e: &Error) -> Option<&Usage> {
+        match e {
+            Error::Usage(u) => u.downcast_ref::<Usage>(),
+            _ => None,
         }
     }
 }
@@ -203,7 +310,7 @@ fn level_of(sc: Supercompression) -> i32 {
 /// container cannot store, round-up sizes where the container fixes them.
 /// The command line reports these as usage errors.
 pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
-    let bad = |u: Usage| Err(Error::Usage(u));
+    let bad = |u: Usage| Err(Error::from(u));
     if s.levels == Some(0) {
         return bad(Usage::LevelsZero);
     }
@@ -262,6 +369,7 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
     if s.resize_to.is_some() && s.normal_map {
         return bad(Usage::ResizeNormalMap);
     }
+    check_env(jobs, s)?;
     let rough_out = s
         .roughness
         .as_ref()
@@ -270,6 +378,7 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
             input: String::new(),
             output,
             kind,
+            faces: Vec::new(),
         });
     if s.rounding == Rounding::Up
         && let Some(j) = jobs
@@ -285,9 +394,48 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
     Ok(())
 }
 
+/// The environment settings' checks that need no input read.
+fn check_env(jobs: &[Job], s: &Settings) -> Result<()> {
+    let bad = |u: Usage| Err(Error::from(u));
+    let e = &s.env;
+    if e.prefilter.is_some() && e.target != Some(Environment::Cube) {
+        return bad(Usage::PrefilterNeedsCube);
+    }
+    if e.irradiance.is_some() && jobs.len() > 1 {
+        return bad(Usage::IrradianceOfBatch);
+    }
+    if let Some(target) = e.target {
+        let kind = match target {
+            Environment::Cube => ImageKind::Cube,
+            Environment::LatLong => ImageKind::LatLong,
+        };
+        if let Some(j) = jobs.iter().find(|j| !j.kind.holds(kind)) {
+            return Err(kind_not_stored(kind, j.kind));
+        }
+    }
+    if let Some((_, k)) = &e.irradiance
+        && !k.holds(ImageKind::Cube)
+    {
+        return Err(kind_not_stored(ImageKind::Cube, *k));
+    }
+    Ok(())
+}
+
+/// [`Usage::KindNotStored`] for `kind` in `container`.
+pub(crate) fn kind_not_stored(kind: ImageKind, container: OutputKind) -> Error {
+    Error::from(Usage::KindNotStored {
+        kind,
+        container: container.name(),
+        holders: crate::io::container::outputs()
+            .filter(|k| k.holds(kind))
+            .map(|k| format!(".{}", k.id()))
+            .collect(),
+    })
+}
+
 /// The checks of a roughness chain's settings `r`.
 fn check_roughness(jobs: &[Job], s: &Settings, r: &RoughnessSettings) -> Result<()> {
-    let bad = |u: Usage| Err(Error::Usage(u));
+    let bad = |u: Usage| Err(Error::from(u));
     if !s.normal_map {
         return bad(Usage::RoughnessNeedsNormalMap);
     }
@@ -377,12 +525,29 @@ mod tests {
             },
             Usage::PackOverwritesAlpha,
             Usage::ExrLevels { full: 7 },
+            Usage::NotForKind {
+                setting: Setting::Wrap,
+                kind: ImageKind::Cube,
+                why: "faces meet at their edges",
+            },
+            Usage::KindNotStored {
+                kind: ImageKind::LatLong,
+                container: "KTX2",
+                holders: vec![".exr".into()],
+            },
+            Usage::NotAnEnvironment {
+                kind: ImageKind::Array { layers: 3 },
+                target: Environment::LatLong,
+            },
+            Usage::PrefilterNeedsCube,
+            Usage::IrradianceNeedsEnvironment,
+            Usage::IrradianceOfBatch,
         ];
         // A long option's prefix, spelt so that a search of the library
         // for flag names in string literals finds none here.
         let flag = "-".repeat(2);
         for u in &all {
-            let text = Error::Usage(u.clone()).to_string();
+            let text = Error::from(u.clone()).to_string();
             assert!(!text.contains(&flag), "{text}");
             assert!(text.starts_with("invalid option: "), "{text}");
         }
@@ -392,23 +557,25 @@ mod tests {
             ..Settings::default()
         };
         assert!(matches!(
-            check(&[job("a.ktx2")], &up),
-            Err(Error::Usage(Usage::RoundingUpNotStored {
+            check(&[job("a.ktx2")], &up)
+                .err()
+                .as_ref()
+                .and_then(Usage::of),
+            Some(Usage::RoundingUpNotStored {
                 container: "KTX2",
                 ..
-            }))
+            })
         ));
         let zstd = Settings {
             supercompression: Some(Supercompression::Zstd(23)),
             ..Settings::default()
         };
         assert!(matches!(
-            check(&[job("a.ktx2")], &zstd),
-            Err(Error::Usage(Usage::SupercompressionLevel {
-                lo: 1,
-                hi: 22,
-                ..
-            }))
+            check(&[job("a.ktx2")], &zstd)
+                .err()
+                .as_ref()
+                .and_then(Usage::of),
+            Some(Usage::SupercompressionLevel { lo: 1, hi: 22, .. })
         ));
         let bc7 = Settings {
             compress: Some((BlockFormat::Bc7, Quality::default())),
@@ -416,11 +583,14 @@ mod tests {
         };
         if cfg!(feature = "encode") {
             assert!(matches!(
-                check(&[job("a.exr")], &bc7),
-                Err(Error::Usage(Usage::BlocksNotStored {
+                check(&[job("a.exr")], &bc7)
+                    .err()
+                    .as_ref()
+                    .and_then(Usage::of),
+                Some(Usage::BlocksNotStored {
                     container: "OpenEXR",
                     ..
-                }))
+                })
             ));
         }
     }

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::io::{self, OutputKind};
 use crate::mip::{self, MipOptions};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
-use crate::texture::Texture;
+use crate::texture::{ImageKind, Texture};
 use crate::wrap::Wrap;
 
 /// How one job is built and written, decided once per job from its
@@ -19,6 +19,8 @@ use crate::wrap::Wrap;
 pub struct Plan {
     /// The output container.
     pub kind: OutputKind,
+    /// What the output holds (a 2-D image, a cube map, an array, ...).
+    pub image_kind: ImageKind,
     /// The stored texel format.
     pub out_format: Format,
     /// The chain's options (the file's wrap mode when no setting names one).
@@ -59,6 +61,21 @@ pub enum BuildPath {
     /// written to OpenEXR as its bands are made, never held whole
     /// ([`io::exr::save_streamed`]).
     FusedExr,
+    /// The layers of an array, each built as a 2-D colour chain (or normal
+    /// vectors) by the whole-level builder.
+    Layers,
+    /// The six faces of each cube map, each built on its own with clamped
+    /// edges, then joined at the edges
+    /// ([`crate::env::cube::fix_edges`]).
+    Faces,
+    /// A lat-long map's levels weighted by solid angle
+    /// ([`crate::env::latlong::build_chain`]), or a cube map made from
+    /// one, or one made from a cube map ([`crate::env::convert`]), in
+    /// linear f32.
+    Environment,
+    /// Prefiltered specular levels of a cube map
+    /// ([`crate::env::prefilter::specular`]), in linear f32.
+    Prefiltered,
 }
 
 impl Plan {
@@ -100,6 +117,7 @@ impl Plan {
         let memory_bytes = memory(path, base, src, out_format, &level_sizes);
         Plan {
             kind: job.kind,
+            image_kind: ImageKind::Plain,
             out_format,
             options,
             level_sizes,
@@ -111,16 +129,21 @@ impl Plan {
 
     /// The chain is built in another format than the source's.
     pub(crate) fn converts(&self) -> bool {
-        !matches!(
+        matches!(
             self.path,
-            BuildPath::Whole | BuildPath::Normal | BuildPath::Roughness
+            BuildPath::Decoded | BuildPath::Streamed | BuildPath::Banded | BuildPath::FusedExr
         )
     }
 }
 
 /// A colour chain is built in linear f32 and converted (the source is not
 /// the output format, or alpha coverage needs unrounded alpha).
-fn converts(src: Format, out: Format, association: Option<AlphaMode>, s: &Settings) -> bool {
+pub(crate) fn converts(
+    src: Format,
+    out: Format,
+    association: Option<AlphaMode>,
+    s: &Settings,
+) -> bool {
     // Alpha coverage is matched on the unrounded filtered alpha (rounding
     // each level to 8 bits first would tie texels the test must separate),
     // so it always builds in f32.
@@ -161,7 +184,13 @@ fn converted_path(
 }
 
 /// The peak bytes `path` holds, estimated (see [`Plan::memory_bytes`]).
-fn memory(path: BuildPath, base: &Texture, src: Format, out: Format, sizes: &[(u32, u32)]) -> u64 {
+pub(crate) fn memory(
+    path: BuildPath,
+    base: &Texture,
+    src: Format,
+    out: Format,
+    sizes: &[(u32, u32)],
+) -> u64 {
     let texels = |k: usize| sizes[k].0 as u64 * sizes[k].1 as u64;
     let source = base.byte_len() as u64;
     let level0 = texels(0) * out.texel_bytes() as u64;
@@ -182,6 +211,13 @@ fn memory(path: BuildPath, base: &Texture, src: Format, out: Format, sizes: &[(u
         // Vectors (three f32 channels) of the whole chain.
         BuildPath::Normal | BuildPath::Roughness => {
             source + texels(0) * 12 * 4 / 3 + level0 + above0
+        }
+        // Per image: one image's working chain beside the output chain
+        // (the images' figures are multiplied by their count).
+        BuildPath::Layers | BuildPath::Faces => source + f32_of(0) * 4 / 3 + level0 + above0,
+        // The f32 chain whole (RGBA for prefiltered levels), then converted.
+        BuildPath::Environment | BuildPath::Prefiltered => {
+            source + texels(0) * 16 * 4 / 3 + level0 + above0
         }
     }
 }

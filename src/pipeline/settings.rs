@@ -4,9 +4,10 @@
 use std::path::PathBuf;
 
 use crate::compress::{BlockFormat, Quality};
+use crate::env::prefilter::Lobe;
 use crate::io::exr::ExrCompression;
 use crate::io::ktx2::Supercompression;
-use crate::io::{Limits, LoadOptions, OutputKind};
+use crate::io::{Environment, Limits, LoadOptions, OutputKind};
 use crate::mip::roughness::{NormalChannels, Specular};
 use crate::mip::{MipFilter, NanPolicy, Rounding};
 use crate::texel::ChannelType;
@@ -87,6 +88,55 @@ pub struct Settings {
     /// Decode the blocks again and measure each level's PSNR
     /// ([`super::BlockLevel::psnr_db`]).
     pub measure_blocks: bool,
+    /// Environment maps: what to build and how (see [`EnvSettings`]).
+    pub env: EnvSettings,
+}
+
+/// How environment maps are built. A file that records an environment
+/// (an OpenEXR `envmap`, a maketx `textureformat`) or holds a cube map
+/// is built as what it holds without any of these.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvSettings {
+    /// Build this environment: a plain image is read as one (six faces in
+    /// a strip or cross, or a lat-long map), and a lat-long source
+    /// becomes a cube map or a cube map a lat-long map when the other is
+    /// asked for ([`crate::io::source::interpret`]).
+    pub target: Option<Environment>,
+    /// Cube faces' size when a lat-long map becomes a cube map (default:
+    /// a quarter of its width).
+    pub face_size: Option<u32>,
+    /// Prefiltered specular levels instead of a plain chain (cube maps):
+    /// the lobe and the lobe directions per texel
+    /// ([`crate::env::prefilter::specular`]).
+    pub prefilter: Option<(Lobe, u32)>,
+    /// Also write the diffuse irradiance (a cube map of 32×32 faces) here.
+    pub irradiance: Option<(PathBuf, OutputKind)>,
+    /// Average the texels along cube faces' edges from level 1 on
+    /// ([`crate::env::cube::fix_edges`]).
+    pub edge_fixup: bool,
+}
+
+impl EnvSettings {
+    /// True when any environment setting is given.
+    pub fn asked(&self) -> bool {
+        self.target.is_some()
+            || self.face_size.is_some()
+            || self.prefilter.is_some()
+            || self.irradiance.is_some()
+            || !self.edge_fixup
+    }
+}
+
+impl Default for EnvSettings {
+    fn default() -> Self {
+        EnvSettings {
+            target: None,
+            face_size: None,
+            prefilter: None,
+            irradiance: None,
+            edge_fixup: true,
+        }
+    }
 }
 
 /// Block-friendly level-0 sizes ([`Settings::resize_to`]).
@@ -168,6 +218,7 @@ impl Default for Settings {
             supercompression: None,
             resize_to: None,
             measure_blocks: false,
+            env: EnvSettings::default(),
         }
     }
 }

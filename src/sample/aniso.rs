@@ -21,9 +21,9 @@
 use super::bilinear::Filters;
 use super::fetch::{Addressing, Chain, Pixel};
 use super::footprint::{Lod, Plan, footprint_f64};
-use super::trace::TexelSink;
 use super::trilinear::{mip_mode, probe};
 use super::{Query, SamplerOptions};
+use crate::trace::TexelSink;
 
 /// What footprint assembly needs per query, worked out before any texel
 /// is read: the shared plan, the probe count, the centre (reduced to the

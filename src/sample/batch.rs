@@ -9,8 +9,8 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 
-use super::trace::{NoTrace, TexelSink};
 use super::{Query, Sampler};
+use crate::trace::{NoTrace, TexelSink};
 
 /// Queries per parallel task.
 pub const CHUNK: usize = 1024;

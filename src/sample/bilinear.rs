@@ -25,7 +25,7 @@
 use crate::wrap::{FAST, WrapMode, fast_floor, floor_index, reduce_coordinate, wrap_index};
 
 use super::fetch::{Addressing, Chain, Pixel, lerp};
-use super::trace::TexelSink;
+use crate::trace::TexelSink;
 
 /// Floor (saturating, as an index) and fraction in [0, 1] of a texel-space
 /// coordinate; the fraction is 0 for non-finite or huge input (there is

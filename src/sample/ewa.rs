@@ -60,8 +60,8 @@ use crate::wrap::{WrapMode, fast_floor};
 use super::bilinear::split;
 use super::fetch::{Addressing, Chain, Pixel, lerp};
 use super::footprint::{Lod, clamp_lod, derivatives, levels_for, log2};
-use super::trace::TexelSink;
 use super::{Query, SamplerOptions};
+use crate::trace::TexelSink;
 
 /// Largest semi-axis, in texels of the level being filtered, that EWA
 /// scans; larger ellipses are shrunk (see the module docs).

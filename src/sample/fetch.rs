@@ -71,7 +71,7 @@ use crate::texel::{ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 use crate::wrap::{Wrap, wrap_index};
 
-use super::trace::TexelSink;
+use crate::trace::TexelSink;
 
 /// A stored texel that decodes to linear RGBA `f32`.
 pub(crate) trait Pixel: bytemuck::Pod + Send + Sync + 'static {

@@ -47,8 +47,8 @@ use crate::wrap::{fast_floor, reduce_coordinate, wrap_index};
 use super::bilinear::split;
 use super::fetch::{Addressing, Chain, Level, Pixel};
 use super::footprint::{Lod, Plan};
-use super::trace::NoTrace;
 use super::{MipMode, Query, SamplerOptions, TexelFilter};
+use crate::trace::NoTrace;
 
 /// A depth comparison function (GL's `GL_TEXTURE_COMPARE_FUNC`, Vulkan's
 /// `VkCompareOp`, WGSL's `sampler_comparison`): the texel passes when

@@ -18,7 +18,7 @@
 //!   supersampled reference (`supersample`). Footprint assembly with
 //!   `max_aniso = 1` is the isotropic lookup, and its probes are isotropic
 //!   lookups sharing one λ and one pair of levels.
-//! - [`trace`]: every filter is generic over a [`TexelSink`] that sees each
+//! - [`crate::trace`]: every filter is generic over a [`TexelSink`] that sees each
 //!   texel read; [`NoTrace`] compiles away.
 //! - `simd`: on x86-64 CPUs with AVX-512 (F, BW, DQ, VL, VBMI), untraced
 //!   bilinear, trilinear and footprint-assembly lookups run 8 queries (or
@@ -90,7 +90,6 @@ mod query;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod simd;
 mod supersample;
-pub mod trace;
 mod trilinear;
 
 use std::fmt;
@@ -103,11 +102,11 @@ use crate::mip::MipChain;
 use crate::sat::SatSampler;
 use crate::wrap::Wrap;
 
+pub use crate::trace::{NoTrace, TexelCounter, TexelRead, TexelRecorder, TexelSink};
 pub use fetch::LinearChain;
 pub use footprint::{Footprint, footprint, mip_linear, mip_nearest};
 pub use gl::{CompareOp, quad_queries};
 pub use query::Query;
-pub use trace::{NoTrace, TexelCounter, TexelRead, TexelRecorder, TexelSink};
 
 use bilinear::{Filters, Lin, MagMin, Near};
 use fetch::{Addressing, Chain, Pixel, with_chain};

@@ -17,9 +17,9 @@ use super::fetch::{Chain, Pixel, Store, Stored, with_chain};
 use super::footprint::Lod;
 #[cfg(target_arch = "x86_64")]
 use super::simd;
-use super::trace::NoTrace;
 use super::trilinear::{self, MIP_LINEAR, MIP_NEAREST, MIP_NONE};
 use super::{Kernel, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
+use crate::trace::NoTrace;
 
 /// The untraced one-query function of a sampler.
 ///

@@ -59,9 +59,9 @@ use super::aniso::Setup;
 use super::bilinear::{Lin, Near};
 use super::fetch::{Addressing, Chain, Lut8, Pixel};
 use super::footprint::{LOG2_BITS, LOG2_POLY, Lod, Plan, UNBOUNDED_TEXELS};
-use super::trace::NoTrace;
 use super::trilinear::{self, MIP_LINEAR, MIP_NEAREST};
 use super::{Query, SamplerOptions, aniso};
+use crate::trace::NoTrace;
 
 /// True when the CPU has the features these paths need and
 /// `PARVO_NO_AVX` is not set (checked once).

@@ -15,8 +15,8 @@
 use super::bilinear::bilinear;
 use super::fetch::{Addressing, Chain, Pixel};
 use super::footprint::{Lod, derivatives};
-use super::trace::TexelSink;
 use super::{Query, SamplerOptions};
+use crate::trace::TexelSink;
 
 /// Supersampled lookup of `q` with `n × n` positions.
 pub(crate) fn supersample<P: Pixel, S: TexelSink>(

@@ -20,8 +20,8 @@
 use super::bilinear::Filters;
 use super::fetch::{Addressing, Chain, Pixel, lerp};
 use super::footprint::{Lod, Plan};
-use super::trace::TexelSink;
 use super::{MipMode, Query, SamplerOptions};
+use crate::trace::TexelSink;
 
 /// Mip mode `none` as a const parameter.
 pub(crate) const MIP_NONE: u8 = 0;

@@ -11,8 +11,8 @@
 
 use super::{AccumulatorKind, AnySat, BoxSum, COORD_LIMIT, Rect, build};
 use crate::error::Result;
-use crate::sample::TexelSink;
 use crate::texture::{Texture, expand_to_rgba};
+use crate::trace::TexelSink;
 use crate::wrap::Wrap;
 use std::sync::Arc;
 
@@ -132,7 +132,7 @@ impl SatSampler {
     /// than the texture cost what small ones do: whole periods are counted,
     /// not visited.
     pub fn sample(&self, u: f32, v: f32, dudx: f32, dvdx: f32, dudy: f32, dvdy: f32) -> [f32; 4] {
-        self.sample_traced(u, v, dudx, dvdx, dudy, dvdy, &mut crate::sample::NoTrace)
+        self.sample_traced(u, v, dudx, dvdx, dudy, dvdy, &mut crate::trace::NoTrace)
     }
 
     /// [`Self::sample`], reporting every table entry it reads to `sink`

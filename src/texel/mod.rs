@@ -9,6 +9,7 @@
 pub(crate) mod codec8;
 pub mod srgb;
 
+use std::borrow::Cow;
 use std::fmt;
 use std::str::FromStr;
 
@@ -641,6 +642,55 @@ pub fn unorm8(v: f32) -> u8 {
 #[inline]
 pub fn unorm16(v: f32) -> u16 {
     (v * 65535.0 + 0.5) as u16
+}
+
+/// The stored values as little-endian bytes (borrowed on little-endian
+/// machines).
+pub fn le_bytes(texels: &Texels) -> Cow<'_, [u8]> {
+    #[cfg(target_endian = "little")]
+    {
+        match texels {
+            Texels::U8(v) => Cow::Borrowed(v.as_slice()),
+            Texels::U16(v) => Cow::Borrowed(bytemuck::cast_slice(v)),
+            Texels::F16(v) => Cow::Borrowed(bytemuck::cast_slice(v.reinterpret_cast())),
+            Texels::F32(v) => Cow::Borrowed(bytemuck::cast_slice(v)),
+        }
+    }
+    #[cfg(not(target_endian = "little"))]
+    {
+        match texels {
+            Texels::U8(v) => Cow::Borrowed(v.as_slice()),
+            Texels::U16(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+            Texels::F16(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+            Texels::F32(v) => Cow::Owned(v.iter().flat_map(|x| x.to_le_bytes()).collect()),
+        }
+    }
+}
+
+/// Texels of the given type from little-endian bytes (length must be a
+/// multiple of the type's size).
+pub fn texels_from_le(ty: ChannelType, bytes: &[u8]) -> Texels {
+    match ty {
+        ChannelType::U8 => Texels::U8(bytes.to_vec()),
+        ChannelType::U16 => Texels::U16(
+            bytes
+                .chunks_exact(2)
+                .map(|b| u16::from_le_bytes([b[0], b[1]]))
+                .collect(),
+        ),
+        ChannelType::F16 => Texels::F16(
+            bytes
+                .chunks_exact(2)
+                .map(|b| half::f16::from_le_bytes([b[0], b[1]]))
+                .collect(),
+        ),
+        ChannelType::F32 => Texels::F32(
+            bytes
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect(),
+        ),
+    }
 }
 
 #[cfg(test)]

@@ -14,8 +14,9 @@ use std::process::Output;
 
 use crate::cli_common;
 
+use parvo::ImageKind;
 use parvo::env::cube::{CubeLayout, build_faces, faces_from_image};
-use parvo::env::{ArraySampler, CubeSampler, DirQuery, Kind};
+use parvo::env::{ArraySampler, CubeSampler, DirQuery};
 use parvo::io::{self, EnvironmentMaps, LoadOptions, OutputKind, SaveOptions};
 use parvo::mip::Rounding;
 use parvo::sample::{Filter, Query, Sampler, SamplerOptions};
@@ -142,7 +143,7 @@ fn crosses_and_strips_are_read_as_cube_maps_by_mip_and_sample() {
             );
             ok(&o, &what);
             let back = load(&out);
-            assert_eq!(back.info.kind, Kind::Cube, "{what}");
+            assert_eq!(back.info.kind, ImageKind::Cube, "{what}");
             let level0: Vec<Texture> = back
                 .into_images()
                 .into_iter()
@@ -259,7 +260,7 @@ fn layer_picks_an_array_layer_as_gl_rounds_it() {
         let path = dir.path().join(format!("array.{ext}"));
         io::save_images(
             &refs,
-            Kind::Array { layers: 3 },
+            ImageKind::Array { layers: 3 },
             Rounding::Down,
             &path,
             kind,
@@ -268,7 +269,7 @@ fn layer_picks_an_array_layer_as_gl_rounds_it() {
         .unwrap();
         let p = path.to_str().unwrap();
         let loaded = load(&path);
-        assert_eq!(loaded.info.kind, Kind::Array { layers: 3 }, "{p}");
+        assert_eq!(loaded.info.kind, ImageKind::Array { layers: 3 }, "{p}");
         let chains = loaded.into_image_chains().unwrap();
         for filter in ["trilinear", "aniso"] {
             let options = SamplerOptions {
@@ -346,7 +347,7 @@ fn layer_picks_the_cube_of_a_cube_map_array() {
     let path = dir.path().join("cubes.ktx2");
     io::save_images(
         &refs,
-        Kind::CubeArray { cubes: 2 },
+        ImageKind::CubeArray { cubes: 2 },
         Rounding::Down,
         &path,
         OutputKind::KTX2,

@@ -10,8 +10,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use parvo::ImageKind;
 use parvo::env::cube::{face_direction, face_st, faces_from_strip, fix_edges, select_face};
-use parvo::env::{Kind, convert, latlong};
+use parvo::env::{convert, latlong};
 use parvo::io::{self, Environment, EnvironmentMaps, LoadOptions, OutputKind, SaveOptions};
 use parvo::mip::Rounding;
 use parvo::{ChannelType, ColorSpace, Format, MipChain, MipOptions, Texture};
@@ -90,19 +91,19 @@ fn chains(faces: Vec<Texture>) -> Vec<MipChain> {
 #[test]
 fn conformance_files_read_as_ktx_extract_reads_them() {
     type Golden<'a> = &'a dyn Fn(usize, usize) -> String;
-    let cases: [(&str, Kind, Golden); 3] = [
-        ("valid_R8G8B8A8_UNORM_CUBE_MIP", Kind::Cube, &|k, i| {
+    let cases: [(&str, ImageKind, Golden); 3] = [
+        ("valid_R8G8B8A8_UNORM_CUBE_MIP", ImageKind::Cube, &|k, i| {
             format!("output_level{k}_face{i}.raw")
         }),
         (
             "valid_R16G16B16A16_UNORM_CUBE_ARRAY_MIP",
-            Kind::CubeArray { cubes: 2 },
+            ImageKind::CubeArray { cubes: 2 },
             // Images are cube by cube: image i is face i % 6 of layer i / 6.
             &|k, i| format!("output_level{k}_face{}_layer{}.raw", i % 6, i / 6),
         ),
         (
             "valid_R8G8B8A8_UNORM_2D_ARRAY_MIP",
-            Kind::Array { layers: 4 },
+            ImageKind::Array { layers: 4 },
             &|k, i| format!("output_level{k}_layer{i}.raw"),
         ),
     ];
@@ -281,7 +282,7 @@ fn supercompressed_cube_maps_round_trip() {
     };
     io::save_images(
         &refs,
-        Kind::CubeArray { cubes: 2 },
+        ImageKind::CubeArray { cubes: 2 },
         Rounding::Down,
         &out,
         OutputKind::KTX2,
@@ -289,7 +290,7 @@ fn supercompressed_cube_maps_round_trip() {
     )
     .unwrap();
     let back = load(&out);
-    assert_eq!(back.info.kind, Kind::CubeArray { cubes: 2 });
+    assert_eq!(back.info.kind, ImageKind::CubeArray { cubes: 2 });
     assert_eq!(back.into_images(), images);
 }
 
@@ -308,7 +309,7 @@ fn openexr_environments_are_strips_and_lat_long_maps_with_envmap() {
     let out = dir.path().join("cube.exr");
     io::save_images(
         &refs,
-        Kind::Cube,
+        ImageKind::Cube,
         Rounding::Down,
         &out,
         OutputKind::EXR,
@@ -346,7 +347,7 @@ fn openexr_environments_are_strips_and_lat_long_maps_with_envmap() {
     let out = dir.path().join("ll.exr");
     io::save_images(
         &[chain.levels()],
-        Kind::LatLong,
+        ImageKind::LatLong,
         Rounding::Down,
         &out,
         OutputKind::EXR,
@@ -364,7 +365,7 @@ fn openexr_environments_are_strips_and_lat_long_maps_with_envmap() {
     let refs: Vec<&[Texture]> = levels.iter().map(|v| v.as_slice()).collect();
     let e = io::save_images(
         &refs,
-        Kind::Cube,
+        ImageKind::Cube,
         Rounding::Down,
         &dir.path().join("odd.exr"),
         OutputKind::EXR,
@@ -376,7 +377,7 @@ fn openexr_environments_are_strips_and_lat_long_maps_with_envmap() {
     // A lat-long map has nowhere to go in KTX2, and says where it can.
     let e = io::save_images(
         &[chain.levels()],
-        Kind::LatLong,
+        ImageKind::LatLong,
         Rounding::Down,
         &dir.path().join("ll.ktx2"),
         OutputKind::KTX2,
@@ -817,22 +818,22 @@ fn dds_cube_maps_and_arrays_round_trip_image_by_image() {
     let f16 = Format::new(4, ChannelType::F16, ColorSpace::Linear);
     // (kind, format, size, caps2, DX10 (dxgi, misc flag, array size))
     let cases = [
-        (Kind::Cube, u8s, 8u32, 0xfe00u32, None),
+        (ImageKind::Cube, u8s, 8u32, 0xfe00u32, None),
         (
-            Kind::Array { layers: 3 },
+            ImageKind::Array { layers: 3 },
             u8s,
             6,
             0,
             Some((28u32, 0u32, 3u32)),
         ),
         (
-            Kind::CubeArray { cubes: 2 },
+            ImageKind::CubeArray { cubes: 2 },
             f16,
             4,
             0xfe00,
             Some((10, 4, 2)),
         ),
-        (Kind::Array { layers: 2 }, grey, 5, 0, Some((61, 0, 2))),
+        (ImageKind::Array { layers: 2 }, grey, 5, 0, Some((61, 0, 2))),
     ];
     for (i, (kind, format, n, caps2, dx10)) in cases.into_iter().enumerate() {
         let mut r = Rng(40 + i as u64);

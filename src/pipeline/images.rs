@@ -1,0 +1,685 @@
+//! The pipeline's path for every image that is not one 2-D texture: cube
+//! maps (a KTX2 or DDS cube, an OpenEXR strip, a strip or a cross, six
+//! face files, or one made from a lat-long map), arrays and cube-map
+//! arrays, and lat-long maps (or one made from a cube map). Planned,
+//! fingerprinted, checked against the settings, built, block-compressed
+//! and written as [`super::process`] does a 2-D texture; only the build
+//! follows the image's kind ([`BuildPath`]).
+
+use std::time::Instant;
+
+use super::blocks::{BlockReport, compress_notes, encode_chain};
+use super::check::kind_not_stored;
+use super::plan::{self, BuildPath, Plan};
+use super::{
+    Job, Note, Outcome, Settings, Stage, Status, Usage, block_label, fingerprint_text, load_notes,
+    output_format_of, read_as, resize, save_options,
+};
+use crate::compress::BlockChain;
+use crate::env::{convert, cube, latlong, prefilter};
+use crate::error::{Error, Result};
+use crate::io::source::{self, Source};
+use crate::io::{self, Environment, EnvironmentMaps, LoadOptions, Loaded, OutputKind, SaveOptions};
+use crate::mip::{self, MipChain, MipFilter, MipOptions, Rounding};
+use crate::setting::Setting;
+use crate::texel::{ChannelType, ColorSpace, Format};
+use crate::texture::{ImageKind, Texture};
+use crate::wrap::{Wrap, WrapMode};
+
+/// The pipeline's load options: the settings' own, with every face, layer
+/// and recorded environment accepted (what the file holds decides the
+/// path, [`holds_images`]).
+pub(super) fn load_options(s: &Settings) -> LoadOptions {
+    LoadOptions {
+        environment: EnvironmentMaps::Accept,
+        ..s.load.clone()
+    }
+}
+
+/// True when `loaded` goes this way: it holds faces or layers, records an
+/// environment, or the settings ask for one.
+pub(super) fn holds_images(loaded: &Loaded, s: &Settings) -> bool {
+    loaded.info.kind != ImageKind::Plain || loaded.info.environment.is_some() || s.env.asked()
+}
+
+/// Runs `job` (see the module docs); `loaded` is its input, or `None` for
+/// a job of six face files.
+pub(super) fn process(
+    job: &Job,
+    s: &Settings,
+    loaded: Option<Loaded>,
+    t_read: Instant,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<Outcome> {
+    let (source, mut input) = read(job, s, loaded, t_read)?;
+    let target = target_kind(source, s)?;
+    let path = build_path(source, target, s);
+    check_kind(job, s, source, target, path)?;
+    let bases = std::mem::take(&mut input.images);
+    let src = input.src;
+    let out_format = match path {
+        // Prefiltered levels are linear RGBA floats (f32 for f32 sources).
+        BuildPath::Prefiltered => {
+            let ty = if src.channel_type == ChannelType::F32 {
+                ChannelType::F32
+            } else {
+                ChannelType::F16
+            };
+            output_format_of(job, s, Format::new(4, ty, ColorSpace::Linear))?
+        }
+        _ => output_format_of(job, s, src)?,
+    };
+    let plan = images_plan(
+        job,
+        s,
+        &bases,
+        src,
+        target,
+        path,
+        out_format,
+        input.file_wrap,
+    );
+    if job.kind.stores().whole_chain {
+        let (w, h) = plan.level_sizes[0];
+        let full = mip::level_count(w, h, s.rounding, None);
+        if s.levels.is_some_and(|n| n < full) {
+            return Err(Error::from(Usage::ExrLevels { full }));
+        }
+    }
+    let fingerprint = fingerprint(s, &plan, &bases);
+    let mut out = Outcome {
+        output: job.output.clone(),
+        status: Status::DryRun,
+        width: plan.level_sizes[0].0,
+        height: plan.level_sizes[0].1,
+        format: out_format,
+        level_sizes: plan.level_sizes.clone(),
+        read_s: input.read_s,
+        build_s: 0.0,
+        write_s: 0.0,
+        notes: std::mem::take(&mut input.notes),
+        blocks: None,
+        block_format: s.compress.map(|(bf, _)| block_label(bf, out_format)),
+        image_kind: target,
+        plan: plan.clone(),
+    };
+    if s.dry_run {
+        return Ok(out);
+    }
+    let stored = |p: &std::path::Path, k| {
+        io::stored_fingerprint(p, k).as_deref() == Some(fingerprint.as_str())
+    };
+    if s.update
+        && stored(&job.output, job.kind)
+        && s.env.irradiance.as_ref().is_none_or(|(p, k)| stored(p, *k))
+    {
+        out.status = Status::UpToDate;
+        return Ok(out);
+    }
+    out.status = Status::Written;
+    let t_build = Instant::now();
+    let images = build(
+        bases,
+        source,
+        target,
+        &plan,
+        src,
+        s,
+        &mut out.notes,
+        progress,
+    )?;
+    out.build_s = t_build.elapsed().as_secs_f64();
+    let blocks = match s.compress {
+        Some((bf, quality)) => {
+            out.notes.extend(compress_notes(bf, src, &plan.level_sizes));
+            let mut chains = Vec::with_capacity(images.len());
+            let mut report: Option<BlockReport> = None;
+            for levels in &images {
+                let (chain, r) = encode_chain(levels, bf, quality, s.measure_blocks, progress)?;
+                chains.push(chain);
+                report = Some(match report {
+                    None => r,
+                    Some(sum) => merge_reports(sum, r),
+                });
+            }
+            Some((chains, report))
+        }
+        None => None,
+    };
+    progress(Stage::Writing);
+    let t_write = Instant::now();
+    write(
+        job,
+        s,
+        &plan,
+        src,
+        fingerprint,
+        &images,
+        blocks.as_ref().map(|b| &b.0),
+    )?;
+    out.write_s = t_write.elapsed().as_secs_f64();
+    out.blocks = blocks.and_then(|(_, r)| r);
+    Ok(out)
+}
+
+/// The fingerprint of a job of `plan` over its images `bases` (every
+/// image's level 0 and every setting that changes the output).
+fn fingerprint(s: &Settings, plan: &Plan, bases: &[Texture]) -> String {
+    let mut text = fingerprint_text(s, &plan.options, &plan.out_format, plan.kind);
+    text += &format!(" image={:?} env={:?}", plan.image_kind, s.env);
+    for b in &bases[1..] {
+        text += " ";
+        text += &io::fingerprint(b, "");
+    }
+    io::fingerprint(&bases[0], &text)
+}
+
+/// Write the built `images` (or their `blocks`) and the irradiance beside
+/// them, through the containers' `save`.
+fn write(
+    job: &Job,
+    s: &Settings,
+    plan: &Plan,
+    src: Format,
+    fingerprint: String,
+    images: &[Vec<Texture>],
+    blocks: Option<&Vec<BlockChain>>,
+) -> Result<()> {
+    let target = plan.image_kind;
+    let save = save_options(s, plan, src, fingerprint, None);
+    match blocks {
+        Some(chains) => io::save_blocks(chains, target, &job.output, job.kind, &save)?,
+        None => {
+            let refs: Vec<&[Texture]> = images.iter().map(Vec::as_slice).collect();
+            io::save_images(&refs, target, s.rounding, &job.output, job.kind, &save)?
+        }
+    }
+    if let Some((path, kind)) = &s.env.irradiance {
+        write_irradiance(images, target, s, path, *kind, &save)?;
+    }
+    Ok(())
+}
+
+/// The input's images (level 0 of each), read as [`super::read`] reads a
+/// 2-D image: interpreted under the settings, NaN policy applied, resized.
+struct Images {
+    images: Vec<Texture>,
+    src: Format,
+    file_wrap: Option<Wrap>,
+    notes: Vec<Note>,
+    read_s: f64,
+}
+
+/// Load (six face files) or interpret `loaded` as a [`Source`], and read
+/// its images.
+fn read(
+    job: &Job,
+    s: &Settings,
+    loaded: Option<Loaded>,
+    t_read: Instant,
+) -> Result<(ImageKind, Images)> {
+    let options = load_options(s);
+    let (source, mut notes, file_wrap) = match loaded {
+        Some(l) => {
+            let notes = load_notes(&l, s);
+            let wrap = l.info.wrap;
+            (source::interpret(l, &job.input, s.env.target)?, notes, wrap)
+        }
+        None => {
+            let faces = job
+                .faces
+                .iter()
+                .map(|f| io::load_with(f, &s.limits, &options))
+                .collect::<Result<Vec<_>>>()?;
+            let notes = load_notes(&faces[0], s);
+            (source::from_faces(faces, &job.faces)?, notes, None)
+        }
+    };
+    let Source { kind, images } = source;
+    let mut bases = Vec::with_capacity(images.len());
+    let mut src = None;
+    let read_s = t_read.elapsed().as_secs_f64();
+    let wrap = image_wrap(kind, s, file_wrap);
+    for mut levels in images {
+        let base = levels.swap_remove(0);
+        let f = read_as(base.format(), s);
+        let mut base = base.reinterpret(f)?;
+        if base.channel_type().is_float() {
+            mip::nan::apply(&mut base, s.nan_policy)?;
+        }
+        let (base, resized) = resize(base, s, wrap)?;
+        if bases.is_empty() {
+            notes.extend(resized);
+        }
+        src.get_or_insert(f);
+        bases.push(base);
+    }
+    let src = src.ok_or_else(|| Error::InvalidOption("the input holds no image".into()))?;
+    Ok((
+        kind,
+        Images {
+            images: bases,
+            src,
+            file_wrap,
+            notes,
+            read_s,
+        },
+    ))
+}
+
+/// The wrap modes images of `kind` are filtered with: the settings' or
+/// the file's for a 2-D image or an array's layers; clamp to edge for
+/// cube faces (their neighbours are joined after, [`cube::fix_edges`])
+/// and lat-long maps (whose builder wraps by longitude itself).
+fn image_wrap(kind: ImageKind, s: &Settings, file_wrap: Option<Wrap>) -> Wrap {
+    match kind {
+        ImageKind::Array { .. } | ImageKind::Plain => s.wrap.or(file_wrap).unwrap_or_default(),
+        _ => Wrap::both(WrapMode::ClampToEdge),
+    }
+}
+
+/// The kind the output holds: the source's, or the environment the
+/// settings ask for (a lat-long map made a cube map, or the reverse).
+fn target_kind(source: ImageKind, s: &Settings) -> Result<ImageKind> {
+    use Environment as E;
+    use ImageKind as K;
+    match (source, s.env.target) {
+        (K::Plain, _) => Err(Error::from(plain_refusal(s))),
+        (k, None) => Ok(k),
+        (K::LatLong | K::Cube, Some(E::LatLong)) => Ok(K::LatLong),
+        (K::LatLong | K::Cube, Some(E::Cube)) => Ok(K::Cube),
+        (kind, Some(target)) => Err(Error::from(Usage::NotAnEnvironment { kind, target })),
+    }
+}
+
+/// Why an environment setting does not apply to one 2-D image.
+fn plain_refusal(s: &Settings) -> Usage {
+    let not = |setting| Usage::NotForKind {
+        setting,
+        kind: ImageKind::Plain,
+        why: "it applies to environment maps (set EnvSettings::target for a 2-D image that \
+              holds one)",
+    };
+    if s.env.irradiance.is_some() {
+        Usage::IrradianceNeedsEnvironment
+    } else if s.env.face_size.is_some() {
+        not(Setting::FaceSize)
+    } else if !s.env.edge_fixup {
+        not(Setting::NoEdgeFixup)
+    } else {
+        not(Setting::Prefilter)
+    }
+}
+
+/// The one place the build path of an image of `source` made into
+/// `target` is decided.
+fn build_path(source: ImageKind, target: ImageKind, s: &Settings) -> BuildPath {
+    if s.env.prefilter.is_some() {
+        BuildPath::Prefiltered
+    } else if source != target || target == ImageKind::LatLong {
+        BuildPath::Environment
+    } else if target.is_cube() {
+        BuildPath::Faces
+    } else {
+        BuildPath::Layers
+    }
+}
+
+/// Every setting that does not apply to this build refused, with why.
+fn check_kind(
+    job: &Job,
+    s: &Settings,
+    source: ImageKind,
+    target: ImageKind,
+    path: BuildPath,
+) -> Result<()> {
+    let not = |setting, why| {
+        Err(Error::from(Usage::NotForKind {
+            setting,
+            kind: target,
+            why,
+        }))
+    };
+    if !job.kind.holds(target) {
+        return Err(kind_not_stored(target, job.kind));
+    }
+    let environment = target.is_cube() || target == ImageKind::LatLong;
+    if s.roughness.is_some() {
+        return not(
+            Setting::Roughness,
+            "a roughness chain is built beside one 2-D normal map",
+        );
+    }
+    if s.normal_map && path != BuildPath::Layers {
+        return not(
+            Setting::NormalMap,
+            "normal maps are built as 2-D textures or arrays of them",
+        );
+    }
+    if environment && s.wrap.is_some() {
+        return not(
+            Setting::Wrap,
+            "cube faces meet their neighbours at the edges and a lat-long map wraps by longitude",
+        );
+    }
+    if environment && s.rounding == Rounding::Up {
+        return not(
+            Setting::Rounding,
+            "cube faces and lat-long maps halve by rounding down, as the GPU and OpenEXR's \
+             environment maps define them",
+        );
+    }
+    if matches!(path, BuildPath::Environment | BuildPath::Prefiltered) && s.alpha_coverage.is_some()
+    {
+        return not(
+            Setting::AlphaCoverage,
+            "alpha coverage is kept per 2-D image (arrays and cube faces), not through a \
+             conversion or a prefilter",
+        );
+    }
+    if target == ImageKind::LatLong && s.filter != MipFilter::Box {
+        return not(
+            Setting::Filter,
+            "a lat-long map's levels are boxes weighted by solid angle (maketx --envlatl's \
+             filter)",
+        );
+    }
+    if s.env.face_size.is_some() && !(source == ImageKind::LatLong && target == ImageKind::Cube) {
+        return not(
+            Setting::FaceSize,
+            "only a lat-long map made into a cube map takes a new face size",
+        );
+    }
+    if !s.env.edge_fixup && !target.is_cube() {
+        return not(Setting::NoEdgeFixup, "only cube faces have edges to join");
+    }
+    if s.env.irradiance.is_some() && !environment {
+        return Err(Error::from(Usage::IrradianceNeedsEnvironment));
+    }
+    Ok(())
+}
+
+/// The plan of an image of `target` from `bases` (level 0 of each source
+/// image, read as `src`).
+#[allow(clippy::too_many_arguments)]
+fn images_plan(
+    job: &Job,
+    s: &Settings,
+    bases: &[Texture],
+    src: Format,
+    target: ImageKind,
+    path: BuildPath,
+    out_format: Format,
+    file_wrap: Option<Wrap>,
+) -> Plan {
+    let (w, h) = (bases[0].width(), bases[0].height());
+    let (w, h) = match (bases.len(), target) {
+        // A lat-long map made a cube map: faces of a quarter of its width.
+        (1, ImageKind::Cube) => {
+            let n = s.env.face_size.unwrap_or((w / 4).max(1));
+            (n, n)
+        }
+        // A cube map made a lat-long map: 4n x 2n.
+        (6, ImageKind::LatLong) => (4 * w, 2 * w),
+        _ => (w, h),
+    };
+    let mut options = plan::mip_options(s, file_wrap, out_format);
+    options.wrap = image_wrap(target, s, file_wrap);
+    let level_sizes = mip::level_sizes(w, h, s.rounding, s.levels);
+    let work = match path {
+        BuildPath::Prefiltered | BuildPath::Environment => {
+            Format::new(4, ChannelType::F32, ColorSpace::Linear).with_alpha(src.alpha)
+        }
+        _ => src,
+    };
+    let association =
+        (out_format.has_alpha() && work.alpha != out_format.alpha).then_some(out_format.alpha);
+    let per_image = plan::memory(path, &bases[0], src, out_format, &level_sizes);
+    Plan {
+        kind: job.kind,
+        image_kind: target,
+        out_format,
+        options,
+        level_sizes,
+        association,
+        path,
+        memory_bytes: per_image * target.images() as u64,
+    }
+}
+
+/// Build every image's chain as `plan` says, stored as its output format.
+#[allow(clippy::too_many_arguments)]
+fn build(
+    bases: Vec<Texture>,
+    source: ImageKind,
+    target: ImageKind,
+    plan: &Plan,
+    src: Format,
+    s: &Settings,
+    notes: &mut Vec<Note>,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<Vec<Vec<Texture>>> {
+    let per_image: u64 = plan.level_sizes[1..]
+        .iter()
+        .map(|&(w, h)| w as u64 * h as u64)
+        .sum();
+    progress(Stage::Building {
+        total_texels: per_image * target.images() as u64,
+    });
+    let (images, clipped) = match plan.path {
+        BuildPath::Layers | BuildPath::Faces => layers(bases, plan, src, s, per_image, progress)?,
+        _ => environment(bases, source, target, plan, src, s)?,
+    };
+    let mut images = images;
+    if target.is_cube() && s.env.edge_fixup {
+        images = join_edges(images, &plan.options)?;
+    }
+    if let Some(c) = clipped {
+        notes.push(Note::Clipped {
+            clipped: c.clipped,
+            texels: c.texels,
+            to: plan.out_format.channel_type,
+        });
+    }
+    Ok(images)
+}
+
+/// Each image built as a 2-D colour chain (or normal vectors), straight
+/// into the output format.
+fn layers(
+    bases: Vec<Texture>,
+    plan: &Plan,
+    src: Format,
+    s: &Settings,
+    per_image: u64,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<(Vec<Vec<Texture>>, Option<mip::band::Clipped>)> {
+    let same = !plan::converts(src, plan.out_format, plan.association, s);
+    let mut images = Vec::with_capacity(bases.len());
+    let mut clipped: Option<mip::band::Clipped> = None;
+    for (i, base) in bases.into_iter().enumerate() {
+        let before = i as u64 * per_image;
+        let mut on_progress = |p: mip::Progress| {
+            progress(Stage::Built {
+                texels_done: before + p.texels_done,
+            })
+        };
+        let levels = if s.normal_map {
+            mip::normal::build(base, &plan.options, plan.out_format, &mut on_progress)?
+        } else {
+            let (levels, c) = mip::band::build_converted(
+                base,
+                &plan.options,
+                src,
+                plan.out_format,
+                plan.association,
+                same,
+                &mut on_progress,
+            )?;
+            if let Some(c) = c {
+                let sum = clipped.get_or_insert(mip::band::Clipped {
+                    clipped: 0,
+                    texels: 0,
+                });
+                sum.clipped += c.clipped;
+                sum.texels += c.texels;
+            }
+            levels
+        };
+        images.push(levels);
+    }
+    Ok((images, clipped))
+}
+
+/// A lat-long map's chain, a conversion between lat-long and cube maps,
+/// or prefiltered levels: built in linear f32, stored once in the output
+/// format.
+fn environment(
+    bases: Vec<Texture>,
+    source: ImageKind,
+    target: ImageKind,
+    plan: &Plan,
+    src: Format,
+    s: &Settings,
+) -> Result<(Vec<Vec<Texture>>, Option<mip::band::Clipped>)> {
+    let f32_of = |b: Texture| {
+        let f = Format::new(b.format().channels, ChannelType::F32, ColorSpace::Linear)
+            .with_alpha(b.format().alpha);
+        b.convert(f)
+    };
+    let mut lin = bases.into_iter().map(f32_of).collect::<Result<Vec<_>>>()?;
+    let levels = plan.level_sizes.len();
+    let full = MipOptions {
+        max_levels: None,
+        ..plan.options
+    };
+    let truncated = |chain: MipChain| {
+        let mut l = chain.into_levels();
+        l.truncate(levels);
+        l
+    };
+    let mut chains: Vec<MipChain> = match (source, target) {
+        (ImageKind::LatLong, ImageKind::LatLong) => {
+            vec![latlong::build_chain(lin.swap_remove(0))?]
+        }
+        (ImageKind::LatLong, _) => {
+            let ll = latlong::build_chain(lin.swap_remove(0))?;
+            let faces = convert::latlong_to_cube(&ll, plan.level_sizes[0].0)?;
+            cube::build_faces(faces, &plan.options)?
+        }
+        (_, ImageKind::LatLong) => {
+            let faces = cube::build_faces(lin, &full)?;
+            let n = faces[0].levels()[0].width();
+            let base = convert::cube_to_latlong(&faces, 4 * n, 2 * n)?;
+            vec![latlong::build_chain(base)?]
+        }
+        _ => cube::build_faces(lin, &plan.options)?,
+    };
+    if let Some((lobe, samples)) = s.env.prefilter {
+        chains = prefilter::specular(&chains, lobe, samples)?;
+    }
+    let count_clipped = src.channel_type.is_float() && !plan.out_format.channel_type.is_float();
+    let mut images = Vec::with_capacity(chains.len());
+    let mut clipped: Option<mip::band::Clipped> = None;
+    for chain in chains {
+        let (l, c) = mip::band::finish_levels(
+            truncated(chain),
+            plan.association,
+            plan.out_format,
+            count_clipped,
+        )?;
+        if let Some(c) = c {
+            let sum = clipped.get_or_insert(mip::band::Clipped {
+                clipped: 0,
+                texels: 0,
+            });
+            sum.clipped += c.clipped;
+            sum.texels += c.texels;
+        }
+        images.push(l);
+    }
+    Ok((images, clipped))
+}
+
+/// Every cube's faces joined at their edges from level 1 on
+/// ([`cube::fix_edges`]).
+fn join_edges(images: Vec<Vec<Texture>>, options: &MipOptions) -> Result<Vec<Vec<Texture>>> {
+    let mut out = Vec::with_capacity(images.len());
+    let mut faces = images.into_iter();
+    loop {
+        let cube: Vec<MipChain> = faces
+            .by_ref()
+            .take(6)
+            .map(|l| MipChain::from_levels(l, *options))
+            .collect::<Result<_>>()?;
+        if cube.is_empty() {
+            return Ok(out);
+        }
+        out.extend(
+            cube::fix_edges(cube, 1)?
+                .into_iter()
+                .map(MipChain::into_levels),
+        );
+    }
+}
+
+/// Two block reports of one job's images as one: bytes and times summed
+/// per level, the worst image's PSNR.
+fn merge_reports(mut a: BlockReport, b: BlockReport) -> BlockReport {
+    for (x, y) in a.levels.iter_mut().zip(b.levels) {
+        x.bytes += y.bytes;
+        x.encode_s += y.encode_s;
+        x.psnr_db = match (x.psnr_db, y.psnr_db) {
+            (Some(p), Some(q)) => Some(p.min(q)),
+            (p, q) => p.or(q),
+        };
+    }
+    a.uncompressed_bytes += b.uncompressed_bytes;
+    a.encode_s += b.encode_s;
+    a
+}
+
+/// The diffuse irradiance of the environment `images` (a cube map's
+/// faces, or a lat-long map made a cube map first), written as a cube
+/// map of 32×32 faces to `path`.
+fn write_irradiance(
+    images: &[Vec<Texture>],
+    target: ImageKind,
+    s: &Settings,
+    path: &std::path::Path,
+    kind: OutputKind,
+    save: &SaveOptions,
+) -> Result<()> {
+    let chain = |l: &Vec<Texture>| MipChain::from_levels(l.clone(), MipOptions::default());
+    let faces: Vec<MipChain> = if target == ImageKind::LatLong {
+        let ll = chain(&images[0])?;
+        let n = (ll.levels()[0].width() / 4).max(1);
+        cube::build_faces(convert::latlong_to_cube(&ll, n)?, &MipOptions::default())?
+    } else {
+        images[..6].iter().map(chain).collect::<Result<_>>()?
+    };
+    let irr = prefilter::irradiance(&faces, 32)?;
+    let ty = s
+        .out_type
+        .filter(|t| kind.supports(*t))
+        .unwrap_or(kind.default_type(ChannelType::F16));
+    let stored = irr
+        .into_iter()
+        .map(|c| {
+            let f = c.levels()[0].format();
+            let out = kind.storable(Format {
+                channel_type: ty,
+                ..f
+            });
+            c.into_levels()
+                .into_iter()
+                .map(|l| mip::band::convert_level(l, out))
+                .collect::<Result<Vec<_>>>()
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let refs: Vec<&[Texture]> = stored.iter().map(Vec::as_slice).collect();
+    if !kind.holds(ImageKind::Cube) {
+        return Err(kind_not_stored(ImageKind::Cube, kind));
+    }
+    io::save_images(&refs, ImageKind::Cube, Rounding::Down, path, kind, save)
+}
