@@ -70,6 +70,7 @@ impl ImageKind {
     pub fn describe(self) -> String {
         match self {
             ImageKind::Plain => "2-D".into(),
+            ImageKind::Array { layers: 1 } => "2-D array, 1 layer".into(),
             ImageKind::Array { layers } => format!("2-D array, {layers} layers"),
             ImageKind::Cube => "cube map (+x -x +y -y +z -z)".into(),
             ImageKind::CubeArray { cubes } => format!("cube map array, {cubes} cubes"),

@@ -134,6 +134,12 @@ pub trait Container: Send + Sync {
         false
     }
 
+    /// True when [`LoadOptions::subimage`] (a part or page other than the
+    /// first) applies to this container's files.
+    fn selects_subimage(&self) -> bool {
+        false
+    }
+
     /// What the container stores as an output; `None` for containers
     /// parvo only reads.
     fn stores(&self) -> Option<Stores> {

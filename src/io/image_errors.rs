@@ -27,16 +27,11 @@ fn decode(format: FileFormat, reason: impl Into<String>) -> Error {
 
 /// Where a decoder needs more memory than the allocation limit allows.
 fn over_limit(format: FileFormat, limits: &Limits) -> Error {
-    let n = limits.max_alloc;
-    let allowed = if n >= 1 << 20 {
-        format!("{} MiB", n >> 20)
-    } else if n >= 1 << 10 {
-        format!("{} KiB", n >> 10)
-    } else {
-        format!("{n} bytes")
-    };
     Error::Limits(format!(
-        "decoding this {format} needs more memory than the allocation limit of {allowed} allows"
+        "decoding this {format} needs more memory than the allocation limit of {} allows \
+         (raise with {})",
+        super::limits::byte_size(limits.max_alloc),
+        crate::setting::Setting::MaxAlloc
     ))
 }
 

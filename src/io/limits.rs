@@ -60,9 +60,9 @@ impl Limits {
         }
         if bytes > self.max_alloc {
             return Err(Error::Limits(format!(
-                "image needs {} MiB, more than the {} MiB allowed (raise with {})",
-                bytes.div_ceil(1 << 20),
-                self.max_alloc / (1 << 20),
+                "image needs {}, more than the {} allowed (raise with {})",
+                byte_size(bytes),
+                byte_size(self.max_alloc),
                 Setting::MaxAlloc
             )));
         }
@@ -89,5 +89,17 @@ mod tests {
         assert!(l.check(100_000, 100_000, 0).is_err());
         assert!(l.check(4096, 4096, 5 << 30).is_err());
         assert!(l.check(4096, 4096, 4096 * 4096 * 4).is_ok());
+    }
+}
+
+/// A byte count in words: `3 MiB`, `12 KiB` or `100 bytes` (rounded up,
+/// so that a count over a limit never reads as equal to it).
+pub(crate) fn byte_size(n: u64) -> String {
+    if n >= 1 << 20 {
+        format!("{} MiB", n.div_ceil(1 << 20))
+    } else if n >= 1 << 10 {
+        format!("{} KiB", n.div_ceil(1 << 10))
+    } else {
+        format!("{n} bytes")
     }
 }

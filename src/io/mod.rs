@@ -663,6 +663,14 @@ fn load_stored(
                 Setting::Channels
             )));
         }
+        if options.subimage != 0 && !container.selects_subimage() {
+            return Err(Error::InvalidOption(format!(
+                "{} picks a part of a multi-part OpenEXR file or a page of a multi-page TIFF; \
+                 this input is a {} file, which holds one",
+                Setting::Subimage,
+                container.name()
+            )));
+        }
         container.load(path, limits, options, overlap)
     }))
     .unwrap_or_else(|p| {

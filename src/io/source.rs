@@ -59,8 +59,13 @@ pub fn interpret(loaded: Loaded, name: &str, hint: Option<Environment>) -> Resul
     let recorded = loaded.info.environment;
     match (recorded, hint) {
         (Some(Environment::Cube), _) => {
-            let faces = faces_from_strip(loaded.base()).map_err(|e| {
-                Error::InvalidOption(format!("cannot read `{name}` as a cube map: {e}"))
+            let (w, h) = (loaded.base().width(), loaded.base().height());
+            let faces = faces_from_strip(loaded.base()).map_err(|_| {
+                Error::InvalidOption(format!(
+                    "`{name}` is a cube-face environment map of {w}x{h}, which parvo reads \
+                     only as OpenEXR's vertical strip of six square faces (w x 6w, +x -x +y -y \
+                     +z -z from the top)"
+                ))
             })?;
             Ok(cube(faces))
         }

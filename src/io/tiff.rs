@@ -927,6 +927,9 @@ fn apply_orientation(
 pub struct Tiff;
 
 impl super::Container for Tiff {
+    fn selects_subimage(&self) -> bool {
+        true
+    }
     fn peek_kind(&self, _head: &[u8], path: &Path) -> Option<crate::texture::ImageKind> {
         Some(peek_kind(path))
     }

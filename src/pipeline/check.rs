@@ -235,7 +235,10 @@ impl Usage {
             Usage::NotForKind { setting, kind, why } => write!(
                 f,
                 "{setting} does not apply to a {}: {why}",
-                kind.describe()
+                match kind {
+                    ImageKind::Plain => "2-D texture".to_string(),
+                    k => k.describe(),
+                }
             ),
             Usage::KindNotStored {
                 kind,

@@ -52,7 +52,12 @@ pub(super) fn process(
     progress: &mut dyn FnMut(Stage),
 ) -> Result<Outcome> {
     let (source, mut input) = read(job, s, loaded, t_read)?;
-    let target = target_kind(source, s)?;
+    let mut target = target_kind(source, s)?;
+    // One layer is all of a one-layer array: a container that holds no
+    // arrays (PNG levels, OpenEXR) gets it as the one 2-D image it is.
+    if target == (ImageKind::Array { layers: 1 }) && !job.kind.holds(target) {
+        target = ImageKind::Plain;
+    }
     let path = build_path(source, target, s);
     check_kind(job, s, source, target, path)?;
     let bases = std::mem::take(&mut input.images);
@@ -316,7 +321,9 @@ fn plain_refusal(s: &Settings) -> Usage {
 fn build_path(source: ImageKind, target: ImageKind, s: &Settings) -> BuildPath {
     if s.env.prefilter.is_some() {
         BuildPath::Prefiltered
-    } else if source != target || target == ImageKind::LatLong {
+    } else if source == ImageKind::LatLong || target == ImageKind::LatLong {
+        // A lat-long map, one made from a cube map, or a cube map made
+        // from one.
         BuildPath::Environment
     } else if target.is_cube() {
         BuildPath::Faces

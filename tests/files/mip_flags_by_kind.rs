@@ -172,12 +172,12 @@ fn table() -> Vec<Row> {
                 "--normal-map",
                 "--roughness",
                 "0.3",
-                "--pack-roughness",
-                "A",
+                "--roughness-out",
+                "ROUGH.ktx2",
             ],
             "ktx2",
             [
-                Yes(Differs),
+                Yes(Writes("ROUGH.ktx2")),
                 No("--roughness"),
                 No("--roughness"),
                 No("--roughness"),
@@ -232,6 +232,8 @@ fn table() -> Vec<Row> {
         row(&["-j", "1"], "ktx2", all(Same)),
         row(&["--no-auto-orient"], "ktx2", all(Same)),
         row(&["--max-width", "8"], "ktx2", [No("--max-width"); 5]),
+        row(&["--subimage", "1"], "ktx2", [No("--subimage"); 5]),
+        row(&["--channels", "R,G,B"], "ktx2", [No("--channels"); 5]),
         row(&["--max-height", "8"], "ktx2", [No("--max-height"); 5]),
         row(&["--max-alloc", "100"], "ktx2", [No("--max-alloc"); 5]),
         Row {
@@ -337,6 +339,20 @@ fn table() -> Vec<Row> {
         ),
     ];
     if cfg!(feature = "encode") {
+        rows.push(Row {
+            both: &["--compress", "bc7"],
+            ..row(
+                &["--quality", "fast"],
+                "ktx2",
+                [
+                    Yes(Differs),
+                    Yes(Differs),
+                    Yes(Differs),
+                    Yes(Differs),
+                    No("--compress"),
+                ],
+            )
+        });
         rows.push(row(
             &["--compress", "bc7"],
             "ktx2",
@@ -432,7 +448,7 @@ fn args(
     }
     for x in extra {
         // Names of files beside the output.
-        a.push(if x.contains("IRR") {
+        a.push(if x.contains("IRR") || x.contains("ROUGH") {
             dir.join(x).to_string_lossy().into_owned()
         } else {
             x.to_string()
@@ -561,6 +577,7 @@ fn every_flag_is_honoured_or_refused_for_every_kind() {
             let out = dir.join(format!("out{r}_{k}.{ext}"));
             let base_out = dir.join(format!("base{r}_{k}.{ext}"));
             let _ = std::fs::remove_file(dir.join("IRR.ktx2"));
+            let _ = std::fs::remove_file(dir.join("ROUGH.ktx2"));
             let base_args = args(kind, row.both, dir, &base_out);
             let mut extra: Vec<&str> = row.both.to_vec();
             extra.extend(row.args);
@@ -614,7 +631,10 @@ fn every_flag_is_honoured_or_refused_for_every_kind() {
         }
         md += &format!(
             "| `{}` | .{} | {} |\n",
-            row.args.join(" ").replace("IRR", "irr"),
+            row.args
+                .join(" ")
+                .replace("IRR", "irr")
+                .replace("ROUGH", "rough"),
             row.ext,
             cells.join(" | ")
         );

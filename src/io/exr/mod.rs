@@ -190,6 +190,9 @@ fn exr_level_sizes(w: u32, h: u32, r: Rounding) -> Vec<(u32, u32)> {
 pub struct OpenExr;
 
 impl super::Container for OpenExr {
+    fn selects_subimage(&self) -> bool {
+        true
+    }
     fn peek_kind(&self, _head: &[u8], path: &Path) -> Option<crate::texture::ImageKind> {
         Some(peek_kind(path))
     }

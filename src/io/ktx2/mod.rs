@@ -345,9 +345,9 @@ impl Supercompression {
 fn decompress(scheme: u32, data: &[u8], len: u64, limits: &Limits) -> Result<Vec<u8>> {
     if len > limits.max_alloc {
         return Err(Error::Limits(format!(
-            "a level declares {} MiB uncompressed, more than the {} MiB allowed (raise with {})",
-            len >> 20,
-            limits.max_alloc >> 20,
+            "a level declares {} uncompressed, more than the {} allowed (raise with {})",
+            super::limits::byte_size(len),
+            super::limits::byte_size(limits.max_alloc),
             crate::setting::Setting::MaxAlloc
         )));
     }

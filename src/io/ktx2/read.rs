@@ -14,9 +14,9 @@ pub(super) fn read_bytes(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
         .len();
     if len > limits.max_alloc {
         return Err(Error::Limits(format!(
-            "file is {} MiB, more than the {} MiB allowed (raise with {})",
-            len >> 20,
-            limits.max_alloc >> 20,
+            "file is {}, more than the {} allowed (raise with {})",
+            crate::io::limits::byte_size(len),
+            crate::io::limits::byte_size(limits.max_alloc),
             crate::setting::Setting::MaxAlloc
         )));
     }
