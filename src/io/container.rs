@@ -456,17 +456,7 @@ pub fn save_images(
     kind: OutputKind,
     options: &SaveOptions,
 ) -> Result<()> {
-    if !kind.holds(image_kind) {
-        return Err(cannot_hold(kind.name(), image_kind, path));
-    }
-    if images.len() != image_kind.images() {
-        return Err(Error::InvalidOption(format!(
-            "a {} holds {} images, got {}",
-            image_kind.describe(),
-            image_kind.images(),
-            images.len()
-        )));
-    }
+    check_images(images.len(), image_kind, path, kind)?;
     let first = images[0];
     check_levels(first, rounding)?;
     if !kind.supports(first[0].channel_type()) {
@@ -507,17 +497,7 @@ pub fn save_blocks(
     kind: OutputKind,
     options: &SaveOptions,
 ) -> Result<()> {
-    if !kind.holds(image_kind) {
-        return Err(cannot_hold(kind.name(), image_kind, path));
-    }
-    if chains.len() != image_kind.images() {
-        return Err(Error::InvalidOption(format!(
-            "a {} holds {} images, got {}",
-            image_kind.describe(),
-            image_kind.images(),
-            chains.len()
-        )));
-    }
+    check_images(chains.len(), image_kind, path, kind)?;
     for (i, c) in chains.iter().enumerate() {
         c.validate()?;
         let shape = |c: &BlockChain| (c.format, c.srgb, c.alpha, c.width, c.height, c.levels.len());
@@ -535,6 +515,21 @@ pub fn save_blocks(
         )));
     }
     kind.0.save_blocks(chains, image_kind, path, options)
+}
+
+/// `count` images make an image of `image_kind`, which `kind` holds.
+fn check_images(count: usize, image_kind: ImageKind, path: &Path, kind: OutputKind) -> Result<()> {
+    if !kind.holds(image_kind) {
+        return Err(cannot_hold(kind.name(), image_kind, path));
+    }
+    if count != image_kind.images() {
+        return Err(Error::InvalidOption(format!(
+            "a {} holds {} images, got {count}",
+            image_kind.describe(),
+            image_kind.images(),
+        )));
+    }
+    Ok(())
 }
 
 /// Every level of `levels` the size `rounding` gives and the format of

@@ -79,6 +79,18 @@ impl Limits {
     }
 }
 
+/// A byte count in words: `3 MiB`, `12 KiB` or `100 bytes` (rounded up,
+/// so that a count over a limit never reads as equal to it).
+pub(crate) fn byte_size(n: u64) -> String {
+    if n >= 1 << 20 {
+        format!("{} MiB", n.div_ceil(1 << 20))
+    } else if n >= 1 << 10 {
+        format!("{} KiB", n.div_ceil(1 << 10))
+    } else {
+        format!("{n} bytes")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -89,17 +101,5 @@ mod tests {
         assert!(l.check(100_000, 100_000, 0).is_err());
         assert!(l.check(4096, 4096, 5 << 30).is_err());
         assert!(l.check(4096, 4096, 4096 * 4096 * 4).is_ok());
-    }
-}
-
-/// A byte count in words: `3 MiB`, `12 KiB` or `100 bytes` (rounded up,
-/// so that a count over a limit never reads as equal to it).
-pub(crate) fn byte_size(n: u64) -> String {
-    if n >= 1 << 20 {
-        format!("{} MiB", n.div_ceil(1 << 20))
-    } else if n >= 1 << 10 {
-        format!("{} KiB", n.div_ceil(1 << 10))
-    } else {
-        format!("{n} bytes")
     }
 }

@@ -137,17 +137,7 @@ pub(super) fn process(
     let blocks = match s.compress {
         Some((bf, quality)) => {
             out.notes.extend(compress_notes(bf, src, &plan.level_sizes));
-            let mut chains = Vec::with_capacity(images.len());
-            let mut report: Option<BlockReport> = None;
-            for levels in &images {
-                let (chain, r) = encode_chain(levels, bf, quality, s.measure_blocks, progress)?;
-                chains.push(chain);
-                report = Some(match report {
-                    None => r,
-                    Some(sum) => merge_reports(sum, r),
-                });
-            }
-            Some((chains, report))
+            Some(encode_images(&images, bf, quality, s, progress)?)
         }
         None => None,
     };
@@ -165,6 +155,28 @@ pub(super) fn process(
     out.write_s = t_write.elapsed().as_secs_f64();
     out.blocks = blocks.and_then(|(_, r)| r);
     Ok(out)
+}
+
+/// Every image's levels encoded as `bf` blocks, and one report of them
+/// all ([`merge_reports`]).
+fn encode_images(
+    images: &[Vec<Texture>],
+    bf: crate::compress::BlockFormat,
+    quality: crate::compress::Quality,
+    s: &Settings,
+    progress: &mut dyn FnMut(Stage),
+) -> Result<(Vec<BlockChain>, Option<BlockReport>)> {
+    let mut chains = Vec::with_capacity(images.len());
+    let mut report: Option<BlockReport> = None;
+    for levels in images {
+        let (chain, r) = encode_chain(levels, bf, quality, s.measure_blocks, progress)?;
+        chains.push(chain);
+        report = Some(match report {
+            None => r,
+            Some(sum) => merge_reports(sum, r),
+        });
+    }
+    Ok((chains, report))
 }
 
 /// The fingerprint of a job of `plan` over its images `bases` (every
@@ -523,14 +535,7 @@ fn layers(
                 same,
                 &mut on_progress,
             )?;
-            if let Some(c) = c {
-                let sum = clipped.get_or_insert(mip::band::Clipped {
-                    clipped: 0,
-                    texels: 0,
-                });
-                sum.clipped += c.clipped;
-                sum.texels += c.texels;
-            }
+            add_clipped(&mut clipped, c);
             levels
         };
         images.push(levels);
@@ -595,17 +600,22 @@ fn environment(
             plan.out_format,
             count_clipped,
         )?;
-        if let Some(c) = c {
-            let sum = clipped.get_or_insert(mip::band::Clipped {
-                clipped: 0,
-                texels: 0,
-            });
-            sum.clipped += c.clipped;
-            sum.texels += c.texels;
-        }
+        add_clipped(&mut clipped, c);
         images.push(l);
     }
     Ok((images, clipped))
+}
+
+/// `c` (one image's clipped texels) added to the job's `sum`.
+fn add_clipped(sum: &mut Option<mip::band::Clipped>, c: Option<mip::band::Clipped>) {
+    if let Some(c) = c {
+        let s = sum.get_or_insert(mip::band::Clipped {
+            clipped: 0,
+            texels: 0,
+        });
+        s.clipped += c.clipped;
+        s.texels += c.texels;
+    }
 }
 
 /// Every cube's faces joined at their edges from level 1 on

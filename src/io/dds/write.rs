@@ -178,13 +178,12 @@ pub(super) fn dx10_of_legacy(lay: &Layout) -> Option<(u32, u32)> {
     })
 }
 
-/// The header of a cube map, an array or a cube-map array of `kind`
-/// whose images each hold `levels`' sizes and format: the legacy cube
-/// flags for one cube map, a DX10 header with `arraySize` for arrays.
-pub fn header_for_images(levels: &[Texture], kind: ImageKind) -> Result<(Header, Layout)> {
-    let (mut header, mut lay) = header_for(levels)?;
+/// The caps of an image of `kind` set in `header` (complex; the cube
+/// flags of a cube map), and its DX10 `arraySize` (cubes or layers);
+/// `None` for one 2-D image, whose header stays as it is.
+pub(super) fn mark_images(header: &mut Header, kind: ImageKind) -> Option<u32> {
     let count = match kind {
-        ImageKind::Plain | ImageKind::LatLong => return Ok((header, lay)),
+        ImageKind::Plain | ImageKind::LatLong => return None,
         ImageKind::Cube => 1,
         ImageKind::CubeArray { cubes } => cubes,
         ImageKind::Array { layers } => layers,
@@ -193,6 +192,17 @@ pub fn header_for_images(levels: &[Texture], kind: ImageKind) -> Result<(Header,
     if kind.is_cube() {
         header.caps2 = caps::CUBEMAP | caps::ALL_FACES;
     }
+    Some(count)
+}
+
+/// The header of a cube map, an array or a cube-map array of `kind`
+/// whose images each hold `levels`' sizes and format: the legacy cube
+/// flags for one cube map, a DX10 header with `arraySize` for arrays.
+pub fn header_for_images(levels: &[Texture], kind: ImageKind) -> Result<(Header, Layout)> {
+    let (mut header, mut lay) = header_for(levels)?;
+    let Some(count) = mark_images(&mut header, kind) else {
+        return Ok((header, lay));
+    };
     if count > 1 && header.dx10.is_none() {
         let (dxgi, mode) = dx10_of_legacy(&lay).ok_or_else(|| {
             encode_err(format!(
@@ -342,16 +352,9 @@ pub fn header_for_block_images(chains: &[BlockChain], kind: ImageKind) -> Result
         .first()
         .ok_or_else(|| encode_err("nothing to write: no images"))?;
     let mut header = header_for_blocks(first)?;
-    let count = match kind {
-        ImageKind::Plain | ImageKind::LatLong => return Ok(header),
-        ImageKind::Cube => 1,
-        ImageKind::CubeArray { cubes } => cubes,
-        ImageKind::Array { layers } => layers,
+    let Some(count) = mark_images(&mut header, kind) else {
+        return Ok(header);
     };
-    header.caps |= caps::COMPLEX;
-    if kind.is_cube() {
-        header.caps2 = caps::CUBEMAP | caps::ALL_FACES;
-    }
     if let Some(d) = &mut header.dx10 {
         d.array_size = count;
         if kind.is_cube() {
