@@ -37,6 +37,41 @@ impl<S: TexelSink + ?Sized> TexelSink for &mut S {
     }
 }
 
+/// [`TexelSink`]'s calls behind a trait object (the trait itself has a
+/// constant, so it cannot be one).
+pub(crate) trait DynSink {
+    fn texel_dyn(&mut self, level: u32, x: u32, y: u32);
+    fn sat_entry_dyn(&mut self, x: u32, y: u32);
+}
+
+impl<S: TexelSink> DynSink for S {
+    #[inline]
+    fn texel_dyn(&mut self, level: u32, x: u32, y: u32) {
+        self.texel(level, x, y);
+    }
+    #[inline]
+    fn sat_entry_dyn(&mut self, x: u32, y: u32) {
+        self.sat_entry(x, y);
+    }
+}
+
+/// Any tracing sink as one type: the samplers' kernels are compiled for
+/// two sinks, [`NoTrace`] and this, instead of once per sink type (the
+/// cache simulator alone has four). A traced read costs one indirect call,
+/// small beside what a sink does with it (a cache lookup, a push).
+pub(crate) struct Erased<'a>(pub &'a mut dyn DynSink);
+
+impl TexelSink for Erased<'_> {
+    #[inline(always)]
+    fn texel(&mut self, level: u32, x: u32, y: u32) {
+        self.0.texel_dyn(level, x, y);
+    }
+    #[inline(always)]
+    fn sat_entry(&mut self, x: u32, y: u32) {
+        self.0.sat_entry_dyn(x, y);
+    }
+}
+
 /// The sink that ignores everything (compiles away).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoTrace;

@@ -92,7 +92,9 @@ pub(crate) fn ewa_slice<P: Pixel, S: TexelSink>(
 ) {
     #[cfg(target_arch = "x86_64")]
     {
-        if avx512 && vector_texels(c) {
+        // `P::PACKED_RGBA8` first: a constant, so the AVX-512 kernel is
+        // not compiled for the storages it never reads.
+        if P::PACKED_RGBA8 && avx512 && vector_texels(c) {
             #[allow(unsafe_code)]
             // SAFETY: the caller's `avx512` says the CPU has AVX-512 F, BW,
             // DQ, VL and VBMI; every AVX-512 CPU also has AVX2 and FMA.
@@ -501,7 +503,7 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
             }
         };
         return if wsum > 0.0 {
-            acc.map(|x| x / wsum)
+            super::map4(acc, |x| x / wsum)
         } else {
             l.fetch(&c.lut, k as u32, ib, jb, a, sink)
         };
@@ -535,7 +537,7 @@ fn ewa_level<P: Pixel, S: TexelSink, const EXACT: bool, const FMA: bool, const V
         )
     };
     if wsum > 0.0 {
-        acc.map(|x| x / wsum)
+        super::map4(acc, |x| x / wsum)
     } else {
         // Unreachable in exact arithmetic (the ellipse contains a texel
         // centre); kept so rounding can never divide by zero.
@@ -774,7 +776,7 @@ pub(crate) fn exact_scan(
         }
     }
     if wsum > 0.0 {
-        acc.map(|x| (x / wsum) as f32)
+        super::map4(acc, |x| (x / wsum) as f32)
     } else {
         // Unreachable in exact arithmetic (the ellipse contains a texel
         // centre); kept so rounding can never divide by zero.

@@ -79,6 +79,10 @@ pub(crate) trait Pixel: bytemuck::Pod + Send + Sync + 'static {
     type Lut: Send + Sync + fmt::Debug + Clone;
     /// Texels are RGBA `f32`, the layout the AVX-512 paths read as it is.
     const RGBA_F32: bool = false;
+    /// Texels are packed RGBA8 (`[u8; 4]`), the only storage the AVX-512
+    /// EWA kernel reads: a constant, so the kernel is compiled for that
+    /// storage alone instead of for all sixteen.
+    const PACKED_RGBA8: bool = false;
     /// The linear-light RGBA value.
     fn decode(self, lut: &Self::Lut) -> [f32; 4];
 
@@ -157,6 +161,7 @@ where
     [u8; N]: bytemuck::Pod,
 {
     type Lut = Lut8;
+    const PACKED_RGBA8: bool = N == 4;
     #[inline(always)]
     fn decode(self, lut: &Lut8) -> [f32; 4] {
         let t = &*lut.table;

@@ -102,6 +102,7 @@ use crate::mip::MipChain;
 use crate::sat::SatSampler;
 use crate::wrap::Wrap;
 
+use crate::trace::Erased;
 pub use crate::trace::{NoTrace, TexelCounter, TexelRead, TexelRecorder, TexelSink};
 pub use fetch::LinearChain;
 pub use footprint::{Footprint, footprint, mip_linear, mip_nearest};
@@ -906,6 +907,16 @@ impl Sampler {
     /// Sample `queries` into `out` (same length) in order, reporting to
     /// `sink`: the one dispatch point of every lookup.
     pub(crate) fn run<S: TexelSink>(&self, queries: &[Query], out: &mut [[f32; 4]], sink: &mut S) {
+        // Two sink types reach the kernels (see `trace::Erased`); `S::TRACES`
+        // is a constant, so each `S` compiles one of the two calls.
+        if S::TRACES {
+            self.run_sink(queries, out, &mut Erased(sink));
+        } else {
+            self.run_sink(queries, out, &mut NoTrace);
+        }
+    }
+
+    fn run_sink<S: TexelSink>(&self, queries: &[Query], out: &mut [[f32; 4]], sink: &mut S) {
         with_chain!(&self.chain.store, c => self.run_on(c, queries, out, sink))
     }
 
@@ -947,6 +958,16 @@ impl Sampler {
         sink: &mut S,
     ) {
         use TexelFilter::{Linear, Nearest};
+        // A traced lookup (the cache simulator's) takes the run-time pair:
+        // the same texels and values, one copy of the kernels instead of
+        // three (a constant test, so untraced code keeps its three).
+        if S::TRACES {
+            let f = MagMin {
+                mag: self.options.mag,
+                min: self.options.min,
+            };
+            return self.run_mip::<P, S, MagMin, ANISO>(c, f, queries, out, sink);
+        }
         match (self.options.mag, self.options.min) {
             (Nearest, Nearest) => self.run_mip::<P, S, Near, ANISO>(c, Near, queries, out, sink),
             (Linear, Linear) => self.run_mip::<P, S, Lin, ANISO>(c, Lin, queries, out, sink),
@@ -1062,6 +1083,14 @@ fn simd_table(chain: &LinearChain) -> Option<simd::LevelTable> {
 
 /// Queries per block of the two-pass loop (see `Sampler::run_texel`).
 const BLOCK: usize = 16;
+
+/// `a.map(f)` for four elements, written out: the standard library's
+/// `map` brings six helper functions per call site, and a generic caller
+/// is copied per storage, filter and level mode (hundreds of copies).
+#[inline(always)]
+pub(crate) fn map4<T: Copy, U>(a: [T; 4], mut f: impl FnMut(T) -> U) -> [U; 4] {
+    [f(a[0]), f(a[1]), f(a[2]), f(a[3])]
+}
 
 /// `out[i] = f(&queries[i])`.
 #[inline(always)]

@@ -18,7 +18,7 @@ use super::footprint::Lod;
 #[cfg(target_arch = "x86_64")]
 use super::simd;
 use super::trilinear::{self, MIP_LINEAR, MIP_NEAREST, MIP_NONE};
-use super::{Kernel, MipMode, Query, Sampler, SamplerOptions, TexelFilter};
+use super::{Kernel, MipMode, Query, Sampler, SamplerOptions, TexelFilter, map4};
 use crate::trace::NoTrace;
 
 /// The untraced one-query function of a sampler.
@@ -212,7 +212,7 @@ fn texel_quad_on<P: Pixel, F: FromOptions, const MIP: u8, const ANISO: bool>(
     let f = F::from_options(o);
     if ANISO {
         let first = aniso::setup::<F, MIP>(lod, o, &qs[0]);
-        let st = qs.map(|q| {
+        let st = map4(*qs, |q| {
             let (u, v) = lod.reduce(&q);
             aniso::Setup { u, v, ..first }
         });
@@ -229,10 +229,12 @@ fn texel_quad_on<P: Pixel, F: FromOptions, const MIP: u8, const ANISO: bool>(
             };
             return out;
         }
-        st.map(|setup| aniso::anisotropic(c, f, &setup, a, &mut NoTrace))
+        map4(st, |setup| {
+            aniso::anisotropic(c, f, &setup, a, &mut NoTrace)
+        })
     } else {
         let plan = trilinear::plan::<F, MIP>(lod, o, &qs[0]);
-        qs.map(|q| {
+        map4(*qs, |q| {
             let (u, v) = lod.reduce(&q);
             trilinear::probe(c, f, &plan, u, v, a, &mut NoTrace)
         })

@@ -46,5 +46,5 @@ pub(crate) fn supersample<P: Pixel, S: TexelSink>(
     }
     // Sums in f64: 4096 f32 additions would lose up to ~1e-4 relative.
     let s = 1.0 / (n * n) as f64;
-    acc.map(|x| (x * s) as f32)
+    super::map4(acc, |x| (x * s) as f32)
 }
