@@ -351,12 +351,12 @@ pub fn fingerprint_text(s: &Settings, opts: &MipOptions, out: &Format, kind: Out
         opts.alpha_coverage,
         opts.normal_map,
         opts.nan_policy,
-        s.tile.0,
-        s.tile.1,
-        s.compression,
+        s.exr.tile.0,
+        s.exr.tile.1,
+        s.exr.compression,
     ) + &format!(
         " compress={:?} supercompression={:?} resize={:?}",
-        s.compress, s.supercompression, s.resize_to
+        s.compress, s.ktx2.supercompression, s.resize_to
     ) + &match &s.roughness {
         Some(r) => format!(
             " roughness={:?} channels={:?} specular={:?} pack={} rough_out={:?}",
@@ -474,10 +474,9 @@ fn save_options(
     SaveOptions {
         channel_names,
         wrap: plan.options.wrap,
-        tile: s.tile,
-        compression: s.compression,
+        exr: s.exr,
         fingerprint: Some(fingerprint),
-        supercompression: s.supercompression,
+        ktx2: s.ktx2,
         attributes: vec![
             ("parvo:filter".into(), s.filter.to_string()),
             ("parvo:source".into(), src.to_string()),
@@ -678,7 +677,7 @@ fn build_and_write(
             src,
             out_format,
             plan.association,
-            !plan.converts(),
+            plan.route,
             &mut on_progress,
         )?;
         out.notes.extend(clipped.map(|c| Note::Clipped {
@@ -754,12 +753,13 @@ fn write_fused(
         src,
         plan.out_format,
         plan.association,
+        plan.route,
         prepared,
     )? {
         Ok(st) => st,
         Err(base) => return Ok(Err(base)),
     };
-    let Some(group) = plan::fused_group(st.band(), s.tile.1 as usize) else {
+    let Some(group) = plan::fused_group(st.band(), s.exr.tile.1 as usize) else {
         return Ok(Err(st.into_base()));
     };
     let mut source = plan::Fused {

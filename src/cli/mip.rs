@@ -453,8 +453,10 @@ fn settings(args: &MipArgs) -> Settings {
         color: args.color.into(),
         alpha: args.alpha.into(),
         out_type: args.out_type,
-        tile: args.tile,
-        compression: args.compression,
+        exr: io::exr::ExrOptions {
+            tile: args.tile,
+            compression: args.compression,
+        },
         load: io::LoadOptions {
             channels: args.channels.clone(),
             subimage: args.subimage,
@@ -481,10 +483,12 @@ fn settings(args: &MipArgs) -> Settings {
                 },
             )
         }),
-        supercompression: match (args.zstd, args.zlib) {
-            (Some(l), _) => Some(Supercompression::Zstd(l)),
-            (None, Some(l)) => Some(Supercompression::Zlib(l)),
-            (None, None) => None,
+        ktx2: io::ktx2::Ktx2Options {
+            supercompression: match (args.zstd, args.zlib) {
+                (Some(l), _) => Some(Supercompression::Zstd(l)),
+                (None, Some(l)) => Some(Supercompression::Zlib(l)),
+                (None, None) => None,
+            },
         },
         resize_to: args.resize_to.map(|r| match r {
             ResizeArg::MultipleOf4 => ResizeTo::MultipleOf4,

@@ -779,14 +779,12 @@ pub fn fingerprint(level0: &Texture, options: &str) -> String {
 }
 
 /// Everything a writer needs besides the levels.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct SaveOptions {
     /// Wrap modes to record.
     pub wrap: Wrap,
-    /// EXR tile size.
-    pub tile: (u32, u32),
-    /// EXR compression.
-    pub compression: exr::ExrCompression,
+    /// OpenEXR's options (tile size, compression).
+    pub exr: exr::ExrOptions,
     /// Fingerprint to record (EXR attribute, KTX2 key/value).
     pub fingerprint: Option<String>,
     /// More attributes to record (EXR, KTX2).
@@ -794,22 +792,8 @@ pub struct SaveOptions {
     /// Channel names for EXR output (one per channel, e.g. the source's
     /// `N.X,N.Y,N.Z`); `None` writes `R,G,B,A`, `Y,A` or `Y`.
     pub channel_names: Option<Vec<String>>,
-    /// KTX2 supercompression of every level (zstd or zlib).
-    pub supercompression: Option<ktx2::Supercompression>,
-}
-
-impl Default for SaveOptions {
-    fn default() -> Self {
-        SaveOptions {
-            wrap: Wrap::default(),
-            tile: (64, 64),
-            compression: exr::ExrCompression::Zip,
-            fingerprint: None,
-            attributes: Vec::new(),
-            channel_names: None,
-            supercompression: None,
-        }
-    }
+    /// KTX2's options (supercompression).
+    pub ktx2: ktx2::Ktx2Options,
 }
 
 /// The fingerprint stored in an existing output (EXR attribute or KTX2

@@ -353,7 +353,7 @@ pub fn check(jobs: &[Job], s: &Settings) -> Result<()> {
             return bad(Usage::BlocksWithRoughness);
         }
     }
-    if let Some(sc) = s.supercompression {
+    if let Some(sc) = s.ktx2.supercompression {
         let (lo, hi) = match sc {
             Supercompression::Zstd(_) => (1, 22),
             Supercompression::Zlib(_) => (1, 12),
@@ -570,7 +570,9 @@ mod tests {
             })
         ));
         let zstd = Settings {
-            supercompression: Some(Supercompression::Zstd(23)),
+            ktx2: crate::io::ktx2::Ktx2Options {
+                supercompression: Some(Supercompression::Zstd(23)),
+            },
             ..Settings::default()
         };
         assert!(matches!(

@@ -454,6 +454,7 @@ fn images_plan(
     let association =
         (out_format.has_alpha() && work.alpha != out_format.alpha).then_some(out_format.alpha);
     let per_image = plan::memory(path, &bases[0], src, out_format, &level_sizes);
+    let route = plan::colour_route(src, out_format, association, s, &options, &level_sizes);
     Plan {
         kind: job.kind,
         image_kind: target,
@@ -462,6 +463,7 @@ fn images_plan(
         level_sizes,
         association,
         path,
+        route,
         memory_bytes: per_image * target.images() as u64,
     }
 }
@@ -513,7 +515,6 @@ fn layers(
     per_image: u64,
     progress: &mut dyn FnMut(Stage),
 ) -> Result<(Vec<Vec<Texture>>, Option<mip::band::Clipped>)> {
-    let same = !plan::converts(src, plan.out_format, plan.association, s);
     let mut images = Vec::with_capacity(bases.len());
     let mut clipped: Option<mip::band::Clipped> = None;
     for (i, base) in bases.into_iter().enumerate() {
@@ -532,7 +533,7 @@ fn layers(
                 src,
                 plan.out_format,
                 plan.association,
-                same,
+                plan.route,
                 &mut on_progress,
             )?;
             add_clipped(&mut clipped, c);

@@ -5,6 +5,7 @@ use std::time::Instant;
 use super::{Job, Settings, Stage};
 use crate::error::{Error, Result};
 use crate::io::{self, OutputKind};
+use crate::mip::band::Route;
 use crate::mip::{self, MipOptions};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::{ImageKind, Texture};
@@ -32,6 +33,9 @@ pub struct Plan {
     pub association: Option<AlphaMode>,
     /// The way through the builder.
     pub path: BuildPath,
+    /// The colour chain's route through `mip::band::build_converted`
+    /// (per image for arrays and faces), decided with `path`.
+    pub(crate) route: Route,
     /// Estimated bytes the build holds at its peak: the source, the
     /// output chain and the f32 working levels of `path` (not measured;
     /// see the band builders of `mip::band` for the figures).
@@ -105,14 +109,13 @@ impl Plan {
         let level_sizes = mip::level_sizes(w, h, s.rounding, s.levels);
         let association =
             (out_format.has_alpha() && src.alpha != out_format.alpha).then_some(out_format.alpha);
+        let route = colour_route(src, out_format, association, s, &options, &level_sizes);
         let path = if s.roughness.is_some() {
             BuildPath::Roughness
         } else if s.normal_map {
             BuildPath::Normal
-        } else if converts(src, out_format, association, s) {
-            converted_path(job.kind, s, src, out_format, &options, &level_sizes)
         } else {
-            BuildPath::Whole
+            converted_path(job.kind, s, route, &options, &level_sizes)
         };
         let memory_bytes = memory(path, base, src, out_format, &level_sizes);
         Plan {
@@ -123,16 +126,9 @@ impl Plan {
             level_sizes,
             association,
             path,
+            route,
             memory_bytes,
         }
-    }
-
-    /// The chain is built in another format than the source's.
-    pub(crate) fn converts(&self) -> bool {
-        matches!(
-            self.path,
-            BuildPath::Decoded | BuildPath::Streamed | BuildPath::Banded | BuildPath::FusedExr
-        )
     }
 }
 
@@ -154,32 +150,59 @@ pub(crate) fn converts(
     !same
 }
 
-/// Which converting path a colour chain takes. A float source holding NaN
-/// or infinities is found only when the build reads it, and goes
-/// [`BuildPath::Decoded`] then (the NaN policy applies to level 0 whole).
+/// The route of a colour chain: in the source's format when it is the
+/// output's, else band by band where a band builder applies, else decoded
+/// whole. A float source holding NaN or infinities is found only when the
+/// build reads it, and is decoded whole then (the NaN policy applies to
+/// level 0 whole).
+pub(crate) fn colour_route(
+    src: Format,
+    out: Format,
+    association: Option<AlphaMode>,
+    s: &Settings,
+    options: &MipOptions,
+    sizes: &[(u32, u32)],
+) -> Route {
+    if !converts(src, out, association, s) {
+        return Route::Whole;
+    }
+    let (w, h) = sizes[0];
+    // A float source to a normalised output clips: decoded whole.
+    if src.channel_type.is_float() && !out.channel_type.is_float() {
+        return Route::Decoded;
+    }
+    if mip::band::box_band_rows(w, h, options).is_some() {
+        Route::Streamed
+    } else if sizes.len() >= 2 && options.alpha_coverage.is_none() && !options.normal_map {
+        Route::Banded
+    } else {
+        Route::Decoded
+    }
+}
+
+/// The build path of a colour chain taking `route`: the fused EXR write
+/// when the output and the band height allow it.
 fn converted_path(
     kind: OutputKind,
     s: &Settings,
-    src: Format,
-    out: Format,
+    route: Route,
     options: &MipOptions,
     sizes: &[(u32, u32)],
 ) -> BuildPath {
-    let (w, h) = sizes[0];
-    let bandable = !src.channel_type.is_float() || out.channel_type.is_float();
-    let band = match mip::band::box_band_rows(w, h, options) {
-        Some(rows) => Some((rows, BuildPath::Streamed)),
-        None => (sizes.len() >= 2 && options.alpha_coverage.is_none() && !options.normal_map)
-            .then_some((1, BuildPath::Banded)),
-    };
-    match band.filter(|_| bandable) {
-        Some((rows, _))
-            if Plan::fuses(kind, s) && fused_group(rows, s.tile.1 as usize).is_some() =>
-        {
-            BuildPath::FusedExr
+    let (path, band) = match route {
+        Route::Whole => return BuildPath::Whole,
+        Route::Decoded => return BuildPath::Decoded,
+        Route::Streamed => {
+            let (w, h) = sizes[0];
+            let rows = mip::band::box_band_rows(w, h, options).unwrap_or(1);
+            (BuildPath::Streamed, rows)
         }
-        Some((_, path)) => path,
-        None => BuildPath::Decoded,
+        Route::Banded => (BuildPath::Banded, 1),
+    };
+    if Plan::fuses(kind, s) && fused_group(band, s.exr.tile.1 as usize).is_some() {
+        BuildPath::FusedExr
+    } else {
+        path
     }
 }
 
@@ -289,7 +312,7 @@ pub(crate) fn prefault_streamed(
     };
     let band = mip::band::box_band_rows(w, h, &options)?;
     // A source already in the output type is built without bands.
-    if !fused || out.channel_type == ty || fused_group(band, s.tile.1 as usize).is_none() {
+    if !fused || out.channel_type == ty || fused_group(band, s.exr.tile.1 as usize).is_none() {
         return None;
     }
     mip::band::prefault(w, h, &options, out)
@@ -387,7 +410,9 @@ mod tests {
         let out = super::super::output_format(src, OutputKind::EXR, &s).unwrap();
         let assoc = Some(AlphaMode::Premultiplied);
         let base = rgba8(w, h).reinterpret(src).unwrap();
-        let Ok(mut st) = Stream::new(base, &options, src, out, assoc, Some(bufs)).unwrap() else {
+        let Ok(mut st) =
+            Stream::new(base, &options, src, out, assoc, Route::Streamed, Some(bufs)).unwrap()
+        else {
             panic!("the box shortcut applies to 256x96");
         };
         let got: Vec<*const u8> = st.level_buffers().iter_mut().map(first_ptr).collect();
@@ -396,7 +421,16 @@ mod tests {
         let mut wrong = prefault_streamed(&exr, &s, 128, 96, 4, ChannelType::U8).unwrap();
         let wrong_ptr = first_ptr(&mut wrong[0]);
         let base = rgba8(w, h).reinterpret(src).unwrap();
-        let Ok(mut st) = Stream::new(base, &options, src, out, assoc, Some(wrong)).unwrap() else {
+        let Ok(mut st) = Stream::new(
+            base,
+            &options,
+            src,
+            out,
+            assoc,
+            Route::Streamed,
+            Some(wrong),
+        )
+        .unwrap() else {
             panic!("the box shortcut applies to 256x96");
         };
         assert_ne!(first_ptr(&mut st.level_buffers()[0]), wrong_ptr);
@@ -416,7 +450,10 @@ mod tests {
         let f16_in = Settings::default(); // half source to half EXR: not converted
         assert!(none(&exr, &f16_in, w, h, ChannelType::F16));
         let tall_tiles = Settings {
-            tile: (64, 63),
+            exr: io::exr::ExrOptions {
+                tile: (64, 63),
+                ..Default::default()
+            },
             ..Settings::default()
         };
         assert!(none(&exr, &tall_tiles, w, h, ChannelType::U8));
@@ -441,7 +478,10 @@ mod tests {
             (
                 "out.exr",
                 Settings {
-                    tile: (64, 63),
+                    exr: io::exr::ExrOptions {
+                        tile: (64, 63),
+                        ..Default::default()
+                    },
                     ..Settings::default()
                 },
                 BuildPath::Streamed,

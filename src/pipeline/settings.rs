@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use crate::compress::{BlockFormat, Quality};
 use crate::env::prefilter::Lobe;
-use crate::io::exr::ExrCompression;
-use crate::io::ktx2::Supercompression;
+use crate::io::exr::ExrOptions;
+use crate::io::ktx2::Ktx2Options;
 use crate::io::{Environment, Limits, LoadOptions, OutputKind};
 use crate::mip::roughness::{NormalChannels, Specular};
 use crate::mip::{MipFilter, NanPolicy, Rounding};
@@ -63,10 +63,8 @@ pub struct Settings {
     /// The output channel type; `None`: the container's default for the
     /// source.
     pub out_type: Option<ChannelType>,
-    /// EXR tile size.
-    pub tile: (u32, u32),
-    /// EXR compression.
-    pub compression: ExrCompression,
+    /// OpenEXR's options (tile size, compression).
+    pub exr: ExrOptions,
     /// Choices the loader cannot make from the file.
     pub load: LoadOptions,
     /// Decoder limits.
@@ -81,8 +79,8 @@ pub struct Settings {
     /// Block-compress every level (KTX2 and DDS; needs the `encode`
     /// feature).
     pub compress: Option<(BlockFormat, Quality)>,
-    /// KTX2 supercompression of every level.
-    pub supercompression: Option<Supercompression>,
+    /// KTX2's options (supercompression of every level).
+    pub ktx2: Ktx2Options,
     /// Resample level 0 first to a block-friendly size.
     pub resize_to: Option<ResizeTo>,
     /// Decode the blocks again and measure each level's PSNR
@@ -207,15 +205,14 @@ impl Default for Settings {
             color: ColorChoice::Auto,
             alpha: AlphaChoice::Auto,
             out_type: None,
-            tile: (64, 64),
-            compression: ExrCompression::default(),
+            exr: ExrOptions::default(),
             load: LoadOptions::default(),
             limits: Limits::default(),
             update: false,
             dry_run: false,
             roughness: None,
             compress: None,
-            supercompression: None,
+            ktx2: Ktx2Options::default(),
             resize_to: None,
             measure_blocks: false,
             env: EnvSettings::default(),

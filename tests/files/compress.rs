@@ -380,7 +380,9 @@ fn ktx2_block_files_follow_the_specification() {
             let srgb = matches!(f, BlockFormat::Bc1 | BlockFormat::Bc3 | BlockFormat::Bc7);
             let (chain, levels) = chain_of(f, 20, srgb);
             let opts = SaveOptions {
-                supercompression: sc,
+                ktx2: parvo::io::ktx2::Ktx2Options {
+                    supercompression: sc,
+                },
                 ..SaveOptions::default()
             };
             let mut b = Vec::new();

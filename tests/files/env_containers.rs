@@ -277,7 +277,9 @@ fn supercompressed_cube_maps_round_trip() {
     let refs: Vec<&[Texture]> = images.iter().map(|v| v.as_slice()).collect();
     let out = dir.path().join("z.ktx2");
     let opts = SaveOptions {
-        supercompression: Some(io::ktx2::Supercompression::Zstd(9)),
+        ktx2: parvo::io::ktx2::Ktx2Options {
+            supercompression: Some(io::ktx2::Supercompression::Zstd(9)),
+        },
         ..SaveOptions::default()
     };
     io::save_images(

@@ -150,8 +150,10 @@ fn every_lossless_compression_round_trips_exactly() {
             }
             let p = dir.path().join(format!("{c}-{ty}.exr"));
             let opts = SaveOptions {
-                compression: c,
-                tile: (32, 16),
+                exr: parvo::io::exr::ExrOptions {
+                    compression: c,
+                    tile: (32, 16),
+                },
                 ..SaveOptions::default()
             };
             io::save(chain.levels(), Rounding::Down, &p, OutputKind::EXR, &opts).unwrap();

@@ -87,7 +87,10 @@ fn overlapped_loads_tell_the_header_and_load_the_same_texels() {
         &exr,
         io::OutputKind::EXR,
         &io::SaveOptions {
-            tile: (16, 16),
+            exr: io::exr::ExrOptions {
+                tile: (16, 16),
+                ..Default::default()
+            },
             ..io::SaveOptions::default()
         },
     )

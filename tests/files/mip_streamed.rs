@@ -212,8 +212,12 @@ fn fused_exr_writes_equal_whole_chain_writes_for_every_tile_shape() {
         ] {
             let case = format!("{filter} {w}x{h}, tile {tile:?}");
             let out = dir.path().join(format!("o{w}_{}x{}.exr", tile.0, tile.1));
-            let settings = Settings {
+            let exr = io::exr::ExrOptions {
                 tile,
+                ..Default::default()
+            };
+            let settings = Settings {
+                exr,
                 filter,
                 ..Settings::default()
             };
@@ -230,7 +234,7 @@ fn fused_exr_writes_equal_whole_chain_writes_for_every_tile_shape() {
             let stored = io::stored_fingerprint(&out, OutputKind::EXR);
             let again = dir.path().join(format!("w{w}_{}x{}.exr", tile.0, tile.1));
             let save = SaveOptions {
-                tile,
+                exr,
                 fingerprint: stored,
                 attributes: vec![
                     ("parvo:filter".into(), filter.to_string()),
@@ -259,7 +263,10 @@ fn fused_exr_writes_equal_whole_chain_writes_for_every_tile_shape() {
         // group size search that never ends.
         let out = dir.path().join(format!("zero{w}.exr"));
         let settings = Settings {
-            tile: (64, 0),
+            exr: parvo::io::exr::ExrOptions {
+                tile: (64, 0),
+                ..Default::default()
+            },
             filter,
             ..Settings::default()
         };

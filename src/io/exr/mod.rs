@@ -58,6 +58,25 @@ mod write;
 pub use read::*;
 pub use write::*;
 
+/// How OpenEXR files are written: the options of this container alone
+/// (`--tile`, `--compression`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ExrOptions {
+    /// Tile size (width, height) of the tiled, mip-mapped file.
+    pub tile: (u32, u32),
+    /// Compression of every tile.
+    pub compression: ExrCompression,
+}
+
+impl Default for ExrOptions {
+    fn default() -> Self {
+        ExrOptions {
+            tile: (64, 64),
+            compression: ExrCompression::default(),
+        }
+    }
+}
+
 /// EXR compression, by the names OpenEXR tools use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum ExrCompression {

@@ -194,7 +194,7 @@ pub(super) fn plan(
     rounding: Rounding,
     opts: &SaveOptions,
 ) -> Result<(Header, Tiles)> {
-    let (tw, th) = opts.tile;
+    let (tw, th) = opts.exr.tile;
     if tw == 0 || th == 0 {
         return Err(encode_err("tile size must be at least 1x1"));
     }
@@ -272,7 +272,7 @@ pub(super) fn plan(
         channels,
     )
     .with_encoding(
-        opts.compression.to_exr(),
+        opts.exr.compression.to_exr(),
         BlockDescription::Tiles(TileDescription {
             tile_size: Vec2(tw as usize, th as usize),
             level_mode,
@@ -281,7 +281,10 @@ pub(super) fn plan(
         LineOrder::Increasing,
     );
     header.own_attributes = attrs;
-    let zip = matches!(opts.compression, ExrCompression::Zip | ExrCompression::Zips);
+    let zip = matches!(
+        opts.exr.compression,
+        ExrCompression::Zip | ExrCompression::Zips
+    );
     let tile = (tw as usize, th as usize);
     Ok((header, Tiles { order, zip, tile }))
 }

@@ -291,6 +291,14 @@ fn lcm(a: u64, b: u64) -> u64 {
     a / gcd(a, b) * b
 }
 
+/// How KTX2 files are written: the options of this container alone
+/// (`--zstd`, `--zlib`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Ktx2Options {
+    /// Supercompression of every level, or none.
+    pub supercompression: Option<Supercompression>,
+}
+
 /// Supercompression of each level's bytes (KTX 2.0 section 3.7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Supercompression {

@@ -220,7 +220,7 @@ pub(super) fn write_payloads(
         kv.extend(kv_entry(k, v));
     }
     // Supercompressed levels: compressed in parallel, written in order.
-    let packed: Option<Vec<Vec<u8>>> = match opts.supercompression {
+    let packed: Option<Vec<Vec<u8>>> = match opts.ktx2.supercompression {
         Some(sc) => Some(
             payloads
                 .par_iter()
@@ -263,7 +263,7 @@ pub(super) fn write_payloads(
         shape.layers,
         shape.faces,
         n as u32,
-        opts.supercompression.map_or(0, |s| s.scheme()),
+        opts.ktx2.supercompression.map_or(0, |s| s.scheme()),
     ] {
         head.extend_from_slice(&v.to_le_bytes());
     }

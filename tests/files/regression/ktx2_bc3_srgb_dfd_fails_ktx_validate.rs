@@ -384,7 +384,9 @@ fn dump(name: &str, bytes: &[u8]) {
 
 fn opts(sc: Option<Supercompression>) -> SaveOptions {
     SaveOptions {
-        supercompression: sc,
+        ktx2: parvo::io::ktx2::Ktx2Options {
+            supercompression: sc,
+        },
         ..SaveOptions::default()
     }
 }

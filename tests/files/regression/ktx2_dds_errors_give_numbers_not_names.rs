@@ -115,7 +115,9 @@ fn a_corrupt_zlib_level_is_said_in_words() {
     .unwrap();
     let mut b = Vec::new();
     let opts = SaveOptions {
-        supercompression: Some(Supercompression::Zlib(6)),
+        ktx2: parvo::io::ktx2::Ktx2Options {
+            supercompression: Some(Supercompression::Zlib(6)),
+        },
         ..SaveOptions::default()
     };
     io::ktx2::write_to(&[t], &opts, &mut b).unwrap();

@@ -16,7 +16,9 @@ use parvo::texel::AlphaMode;
 
 fn zstd() -> SaveOptions {
     SaveOptions {
-        supercompression: Some(Supercompression::Zstd(19)),
+        ktx2: parvo::io::ktx2::Ktx2Options {
+            supercompression: Some(Supercompression::Zstd(19)),
+        },
         ..SaveOptions::default()
     }
 }
@@ -65,7 +67,9 @@ fn a_declared_uncompressed_length_is_checked_before_it_is_allocated() {
     let tex = parvo::builtin::load("builtin:checker:8").unwrap();
     for scheme in [Supercompression::Zlib(6), Supercompression::Zstd(3)] {
         let opts = SaveOptions {
-            supercompression: Some(scheme),
+            ktx2: parvo::io::ktx2::Ktx2Options {
+                supercompression: Some(scheme),
+            },
             ..SaveOptions::default()
         };
         let mut b = Vec::new();

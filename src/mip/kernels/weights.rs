@@ -16,7 +16,7 @@
 //! - An axis that does not shrink (`src == dst`, e.g. the 1-texel axis of an
 //!   N×1 level) is the identity.
 
-use super::MipFilter;
+use crate::mip::MipFilter;
 use crate::wrap::{WrapMode, wrap_index};
 
 /// Weights of one axis in a flat, fixed-tap layout (padded with zero

@@ -7,7 +7,7 @@
 //! touch alone costs more than the whole chain's arithmetic. Here level 0
 //! is cut into bands of 2^m rows; each band is decoded to linear f32 in a
 //! per-thread scratch buffer, reduced through levels 1..=m with the 2×2
-//! row kernel ([`super::fast::box_row_f32`]), and each level's new rows
+//! row kernel ([`crate::mip::fast::box_row_f32`]), and each level's new rows
 //! are encoded to the stored type while they are in cache. Only level m
 //! is kept in f32 (1/4^m of level 0), to build the rest of the chain from.
 //! Decoding, the row kernel and encoding are row-local, so the levels are
@@ -15,8 +15,8 @@
 
 use rayon::prelude::*;
 
-use super::fast::box_row_f32;
-use super::{MipFilter, MipOptions, srgb_simd};
+use crate::mip::fast::box_row_f32;
+use crate::mip::{MipFilter, MipOptions, srgb_simd};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels, TexelsMut};
 use crate::texture::Texture;
 
@@ -52,7 +52,7 @@ pub fn levels(sizes: &[(u32, u32)], options: &MipOptions) -> usize {
 /// channels, alpha-weighted by channel `straight`) reduced by the 2×2 box
 /// into `next` (resized to `lw / 2` × `lr / 2`). The level kernel of every
 /// band-by-band box build: the whole-level one here ([`box_levels`]) and
-/// the one that stores another format ([`super::band`]). True when every
+/// the one that stores another format ([`crate::mip::band`]). True when every
 /// value came out finite.
 pub(crate) fn reduce_band(
     prev: &[f32],
@@ -90,7 +90,7 @@ fn fused_level1(
     let (row, nrow) = (4 * w, 2 * w);
     let rows = band.len() / row.max(1);
     next.resize(nrow * (rows / 2), 0.0);
-    let t = super::fast::fixed_tables();
+    let t = crate::mip::fast::fixed_tables();
     let mut scratch = Vec::new();
     for (r, (d, lin)) in codes
         .chunks_exact_mut(nrow)

@@ -2,7 +2,7 @@
 //! Mitchell, triangle, and the box on sizes that do not halve): AVX-512
 //! where the CPU has it (F, BW, DQ, VL, VBMI, detected once at run time;
 //! `PARVO_NO_AVX` turns it off), else the AVX2 kernel of
-//! [`super::separable`], else its portable one.
+//! [`crate::mip::separable`], else its portable one.
 //!
 //! - Vertical pass: 64 values per step in four zmm registers, one fused
 //!   multiply-add per register and source row.
@@ -20,7 +20,7 @@
 
 use std::collections::HashMap;
 
-use super::weights::AxisWeights;
+use crate::mip::weights::AxisWeights;
 
 /// One axis's weights expanded per channel: for each distinct weight
 /// pattern, `pad` floats (tap `t`, channel `c` at `t · ch + c`, zeros
@@ -143,7 +143,7 @@ pub(crate) fn filter_row(
         return;
     }
     let _ = ex;
-    super::separable::filter_row(rows, tmp, dst, wx, runs, ch);
+    crate::mip::separable::filter_row(rows, tmp, dst, wx, runs, ch);
 }
 
 /// Destination texel `x` from its taps by index (wrapped edges).

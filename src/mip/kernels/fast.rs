@@ -21,15 +21,15 @@
 //! value, so no weighting work is done. A block with all alpha 0 keeps the
 //! plain colour average, as the separable path does.
 //!
-//! Every path here is compared with [`super::separable`] in
+//! Every path here is compared with [`crate::mip::separable`] in
 //! `tests/core/mip_fast_paths_match_plain.rs`.
 
 use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
-use super::{MipFilter, MipOptions, srgb_simd};
 use crate::error::Result;
+use crate::mip::{MipFilter, MipOptions, srgb_simd};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels, srgb};
 use crate::texture::Texture;
 
@@ -40,7 +40,7 @@ const TASK_BYTES: usize = 64 * 1024;
 /// path". The flag is true when the kernel saw every output value finite
 /// (only the f32 RGBA kernel tracks it; it lets the deferred NaN check
 /// skip its scan of level 1).
-pub fn try_reduce(
+pub(crate) fn try_reduce(
     src: &Texture,
     w: u32,
     h: u32,
@@ -80,7 +80,7 @@ pub fn try_reduce(
 /// encoded to it while in cache (the stored level: [`ReducedLinear::stored`]).
 /// `None` when the box does not apply (another filter, or sizes that do
 /// not halve exactly).
-pub fn try_reduce_linear(
+pub(crate) fn try_reduce_linear(
     src: &Texture,
     w: u32,
     h: u32,
@@ -167,7 +167,7 @@ pub fn try_reduce_linear(
 }
 
 /// What [`try_reduce_linear`] made.
-pub struct ReducedLinear {
+pub(crate) struct ReducedLinear {
     /// The level in linear f32, unrounded.
     pub linear: Vec<f32>,
     /// The level encoded to the 8-bit format asked for, if any.
@@ -525,7 +525,7 @@ const BUCKETS: usize = 8192;
 /// threshold; the 4097 buckets in use (16 KiB) stay in the L1 cache.
 const BUCKET_SHIFT: u32 = 14;
 
-pub(super) fn fixed_tables() -> &'static FixedSrgb {
+pub(crate) fn fixed_tables() -> &'static FixedSrgb {
     static T: OnceLock<FixedSrgb> = OnceLock::new();
     T.get_or_init(|| {
         let mut dec = [0u32; 256];

@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
-use super::{MipOptions, Progress};
+use crate::mip::{MipOptions, Progress};
 
 /// Make the first three of every `ch` values a unit vector (+Z for a zero
 /// or non-finite one).
@@ -119,12 +119,12 @@ pub fn build_levels(
     // NaN/Inf policy first: decoding would turn them into +Z unseen.
     let repaired;
     let base = if base.channel_type().is_float() {
-        if options.nan_policy == super::NanPolicy::Error {
-            super::nan::check(base)?;
+        if options.nan_policy == crate::mip::NanPolicy::Error {
+            crate::mip::nan::check(base)?;
             base
         } else {
             let mut b = base.clone();
-            super::nan::apply(&mut b, options.nan_policy)?;
+            crate::mip::nan::apply(&mut b, options.nan_policy)?;
             repaired = b;
             &repaired
         }
@@ -134,11 +134,11 @@ pub fn build_levels(
     let v0 = to_vectors(base)?;
     let plain = MipOptions {
         normal_map: false,
-        nan_policy: super::NanPolicy::Error,
+        nan_policy: crate::mip::NanPolicy::Error,
         ..*options
     };
     // The chain of averages, unnormalised; the output is renormalised.
-    let averages = super::build_with_progress(v0, &plain, progress)?;
+    let averages = crate::mip::build_with_progress(v0, &plain, progress)?;
     let ch = base.channels();
     let mut out = averages.into_levels();
     for l in &mut out {

@@ -28,8 +28,8 @@ use crate::error::{Error, Result};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
-use super::normal::normalize_vectors;
-use super::{MipOptions, Progress};
+use crate::mip::normal::normalize_vectors;
+use crate::mip::{MipOptions, Progress};
 
 /// Below this `1 − r` a texel's normals count as not spread at all. The
 /// f32 average of identical unit vectors is within a few ulps of unit
@@ -73,7 +73,7 @@ pub enum Specular {
 #[derive(Clone, Debug)]
 pub struct RoughnessChain {
     /// Unit normals, three channels, linear f32 (encode them for output
-    /// with [`super::normal::encode`]).
+    /// with [`crate::mip::normal::encode`]).
     pub normals: Vec<Texture>,
     /// One channel, linear f32: α' per texel, or s' for
     /// [`Specular::BlinnPhong`].
@@ -176,7 +176,7 @@ pub fn build(
     }
     let plain = MipOptions {
         normal_map: false,
-        nan_policy: super::NanPolicy::Error,
+        nan_policy: crate::mip::NanPolicy::Error,
         ..*options
     };
     // The base roughness chain first: its errors come before any work.
@@ -190,10 +190,10 @@ pub fn build(
     };
     let mut nf = normals.clone();
     if nf.channel_type().is_float() {
-        super::nan::apply(&mut nf, options.nan_policy)?;
+        crate::mip::nan::apply(&mut nf, options.nan_policy)?;
     }
     let v0 = unit_vectors(&nf, channels)?;
-    let averages = super::build_with_progress(v0, &plain, progress)?.into_levels();
+    let averages = crate::mip::build_with_progress(v0, &plain, progress)?.into_levels();
     let mut out_n = Vec::with_capacity(averages.len());
     let mut out_s = Vec::with_capacity(averages.len());
     for (k, mut lvl) in averages.into_iter().enumerate() {
@@ -270,5 +270,5 @@ fn roughness_levels(m: &Texture, normals: &Texture, options: &MipOptions) -> Res
     }
     let f = Format::new(1, ChannelType::F32, ColorSpace::Linear).with_alpha(AlphaMode::None);
     let t = Texture::from_f32(m.width(), m.height(), f, first)?;
-    Ok(super::build(t, options)?.into_levels())
+    Ok(crate::mip::build(t, options)?.into_levels())
 }

@@ -1,5 +1,5 @@
 //! AVX-512 kernel for the sRGB RGBA8 2×2 box, bit-exact with the scalar
-//! table kernel in [`super::fast`].
+//! table kernel in [`crate::mip::fast`].
 //!
 //! The scalar kernel spends its time on table look-ups (twelve decodes and
 //! three encode buckets per output texel), and AVX2 gathers are slow on the
@@ -37,7 +37,7 @@
 //! Rows narrower than one block, and the last `width mod 16` texels of a
 //! row, use the scalar kernel too.
 
-use super::fast::{FixedSrgb, row_u8_srgb_n};
+use crate::mip::fast::{FixedSrgb, row_u8_srgb_n};
 
 /// True when the AVX-512 kernel may run: the CPU has the features and
 /// `PARVO_NO_AVX` is not set (read once).
@@ -559,8 +559,8 @@ mod x86 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::fast::{FixedSrgb, fixed_tables, row_u8_srgb_n};
     use super::row_rgba8;
+    use crate::mip::fast::{FixedSrgb, fixed_tables, row_u8_srgb_n};
 
     /// Whether this machine can run the AVX-512 kernel (else the tests
     /// that need it pass vacuously, saying so).

@@ -26,9 +26,9 @@ use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
-use super::MipOptions;
-use super::weights::{self, AxisWeights};
 use crate::error::Result;
+use crate::mip::MipOptions;
+use crate::mip::weights::{self, AxisWeights};
 use crate::texel::{self, AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
@@ -38,7 +38,12 @@ const ALPHA_EPS: f32 = 1e-7;
 /// Reduce `src` to `w × h` (see the module docs). The flag is true when
 /// every filtered value was finite (checked row by row while in cache, so
 /// the deferred NaN check need not scan the level again).
-pub fn reduce(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Result<(Texture, bool)> {
+pub(crate) fn reduce(
+    src: &Texture,
+    w: u32,
+    h: u32,
+    options: &MipOptions,
+) -> Result<(Texture, bool)> {
     let (linear, finite) = reduce_linear_checked(src, w, h, options);
     let fmt = src.format();
     if fmt.channel_type == ChannelType::F32 && fmt.color_space == ColorSpace::Linear {
@@ -69,12 +74,7 @@ pub(crate) fn linear_source(src: &Texture) -> Cow<'_, [f32]> {
 /// otherwise those rows are premultiplied into scratch on the fly. Each
 /// source row's "one alpha" test runs once, just before its first use,
 /// while the row is being brought into cache anyway (no separate pass over
-/// the level).
-pub fn reduce_linear(src: &Texture, w: u32, h: u32, options: &MipOptions) -> Vec<f32> {
-    reduce_linear_checked(src, w, h, options).0
-}
-
-/// [`reduce_linear`], and whether every value is finite.
+/// the level). Also returns whether every value is finite.
 pub(crate) fn reduce_linear_checked(
     src: &Texture,
     w: u32,
@@ -125,7 +125,7 @@ pub(crate) struct Reducer {
     pub(crate) straight: Option<usize>,
     /// The fast row kernel's expanded weights ([`Reducer::fast`]); `None`:
     /// the plain kernel, the reference.
-    ex: Option<super::sep_simd::Expanded>,
+    ex: Option<crate::mip::sep_simd::Expanded>,
 }
 
 impl Reducer {
@@ -162,10 +162,10 @@ impl Reducer {
         }
     }
 
-    /// The same reduction with the fast row kernel ([`super::sep_simd`]):
+    /// The same reduction with the fast row kernel ([`crate::mip::sep_simd`]):
     /// the same values up to the order of the sums.
     pub(crate) fn fast(mut self) -> Reducer {
-        self.ex = Some(super::sep_simd::Expanded::new(&self.wx, self.ch));
+        self.ex = Some(crate::mip::sep_simd::Expanded::new(&self.wx, self.ch));
         self
     }
 
@@ -174,7 +174,7 @@ impl Reducer {
     fn filter(&self, rows: &[(&[f32], f32)], tmp: &mut [f32], dst: &mut [f32]) {
         match &self.ex {
             Some(ex) => {
-                super::sep_simd::filter_row(rows, tmp, dst, &self.wx, &self.runs, ex, self.ch)
+                crate::mip::sep_simd::filter_row(rows, tmp, dst, &self.wx, &self.runs, ex, self.ch)
             }
             None => filter_row(rows, tmp, dst, &self.wx, &self.runs, self.ch),
         }

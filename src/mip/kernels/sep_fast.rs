@@ -1,6 +1,6 @@
 //! The fast separable reduction (Kaiser, Lanczos3, Mitchell, triangle,
 //! and the box where it does not halve) of a whole level, beside the plain
-//! path of [`super::separable`] (the reference, `fast_paths: false`).
+//! path of [`crate::mip::separable`] (the reference, `fast_paths: false`).
 //!
 //! The plain path decodes the whole source to linear f32 first: for a
 //! 4096² RGBA8 level 0 that is 256 MiB of fresh pages written and read
@@ -10,21 +10,21 @@
 //! 64 KiB at 2:1 for a 4096-wide RGBA level, in L2), each decoded once per
 //! band through the 256-entry tables (8-bit) or the 16-bit ones, in place
 //! for a linear f32 level (the working levels of the chain). Each new row
-//! goes through the fast row kernel ([`super::sep_simd`]) and, when the
+//! goes through the fast row kernel ([`crate::mip::sep_simd`]) and, when the
 //! chain asks for it, is encoded to the stored format while in cache, so
 //! no separate encode pass reads the level back.
 //!
 //! Straight alpha, the "one alpha per row" test, the fully transparent
 //! fallback and the finite check are the plain path's own
-//! ([`super::separable::Reducer::row`]); only the order of the sums in the
+//! ([`crate::mip::separable::Reducer::row`]); only the order of the sums in the
 //! row kernel differs (`tests/files/mip_separable_fast.rs` holds every level of
 //! the fast chains within one code of the plain ones).
 
 use rayon::prelude::*;
 
-use super::MipOptions;
-use super::fast::ReducedLinear;
-use super::separable::{Reducer, one_alpha, one_alpha_u8};
+use crate::mip::MipOptions;
+use crate::mip::fast::ReducedLinear;
+use crate::mip::separable::{Reducer, one_alpha, one_alpha_u8};
 use crate::texel::{ChannelType, ColorSpace, Format, Texels, TexelsMut};
 use crate::texture::Texture;
 

@@ -5,7 +5,7 @@
 //!
 //! [`build_converted`] is the whole-chain entry: it takes the band-by-band
 //! builders where they apply and otherwise decodes level 0 once to linear
-//! f32, builds with [`super::build_with_progress`] and converts each level
+//! f32, builds with [`crate::mip::build_with_progress`] and converts each level
 //! once. [`Stream`] hands level 0's rows out band by band for a writer
 //! that never holds level 0 in the output type (the fused EXR write,
 //! [`crate::io::exr::save_streamed`]), then the rest of the chain.
@@ -13,19 +13,19 @@
 //! Two builders, both bit for bit the whole-image chain
 //! (`tests/files/mip_streamed.rs`):
 //! - [`Streamer`], the 2×2 box of levels that halve exactly: the box row
-//!   kernel of [`super::stream`] (the whole-level build's own band kernel)
+//!   kernel of [`crate::mip::band::boxes`] (the whole-level build's own band kernel)
 //!   with each level's rows associated and encoded into the output type;
 //! - [`Banded`], every other filter, size and wrap mode: level 0 encoded
 //!   band by band, level 1 filtered from level-0 rows
-//!   ([`super::separable::Reducer::band`]), the rest built from level 1.
+//!   ([`crate::mip::separable::Reducer::band`]), the rest built from level 1.
 //!
 //! Both share the tail with the whole-level build: the chain below the
-//! levels made band by band is [`super::build_with_progress`]'s.
+//! levels made band by band is [`crate::mip::build_with_progress`]'s.
 
 use rayon::prelude::*;
 
-use super::{MipChain, MipFilter, MipOptions, Progress};
 use crate::error::{Error, Result};
+use crate::mip::{MipChain, MipFilter, MipOptions, Progress};
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
@@ -56,7 +56,7 @@ fn rest_of_chain(
         max_levels: Some((sizes.len() - first) as u32),
         ..*options
     };
-    let chain = super::build_with_progress(level, &rest_options, &mut |q| {
+    let chain = crate::mip::build_with_progress(level, &rest_options, &mut |q| {
         progress(chain_progress(
             sizes,
             q.levels_done + first as u32,
@@ -78,28 +78,32 @@ pub(crate) enum Stream<'a> {
 }
 
 impl<'a> Stream<'a> {
-    /// The box shortcut where it applies, else the general build;
-    /// `Err(base)` when neither does (the whole-image build then makes
-    /// the chain). `src` is `base`'s format as the build reads it,
-    /// `out_format` the stored one, `association` the alpha mode the
-    /// levels change to. `prepared`: the box shortcut's levels 1..=m, if
-    /// made beforehand ([`prefault`]).
+    /// The builder `route` names ([`Route::Streamed`] or
+    /// [`Route::Banded`]); `Err(base)` for another route, or when the
+    /// source turns out not to be bandable (a float source holding NaN or
+    /// infinities, found only as it is read). `src` is `base`'s format as
+    /// the build reads it, `out_format` the stored one, `association` the
+    /// alpha mode the levels change to. `prepared`: the box shortcut's
+    /// levels 1..=m, if made beforehand ([`prefault`]).
     pub(crate) fn new(
         base: Texture,
         options: &'a MipOptions,
         src: Format,
         out_format: Format,
         association: Option<AlphaMode>,
+        route: Route,
         prepared: Option<Vec<Texels>>,
     ) -> Result<std::result::Result<Self, Texture>> {
-        Ok(
-            match Streamer::new(base, options, src, out_format, association, prepared)? {
-                Ok(st) => Ok(Stream::Box(st)),
-                Err(base) => {
-                    Banded::new(base, options, src, out_format, association).map(Stream::General)
-                }
-            },
-        )
+        Ok(match route {
+            Route::Streamed => {
+                Streamer::new(base, options, src, out_format, association, prepared)?
+                    .map(Stream::Box)
+            }
+            Route::Banded => {
+                Banded::new(base, options, src, out_format, association).map(Stream::General)
+            }
+            Route::Whole | Route::Decoded => Err(base),
+        })
     }
 
     /// The whole chain, level 0 into one buffer.
@@ -202,7 +206,7 @@ pub(crate) fn prefault(w: u32, h: u32, options: &MipOptions, out: Format) -> Opt
 /// of any level: level 0 is cut into bands of 2^m rows (m ≤ 6 levels that
 /// halve exactly: both sides divisible by 2^m, m ≤ 4), and each band, on its own
 /// thread, is decoded to linear f32, reduced through levels 1..m with the
-/// box row kernel of the whole-level path ([`super::fast`]), and every
+/// box row kernel of the whole-level path ([`crate::mip::fast`]), and every
 /// level's rows are alpha-associated and encoded into the output type as
 /// soon as they exist. Level m's f32 rows are kept (1/4^m of level 0) and
 /// the rest of the chain is built from them as before. Decoding, the row
@@ -241,9 +245,9 @@ impl<'a> Streamer<'a> {
     /// the shortcut applies to a `w`×`h` level 0 built with `options`
     /// (whatever its texels).
     fn plan(w: u32, h: u32, options: &MipOptions) -> Option<(Vec<(u32, u32)>, usize)> {
-        let sizes = super::level_sizes(w, h, options.rounding, options.max_levels);
+        let sizes = crate::mip::level_sizes(w, h, options.rounding, options.max_levels);
         // The whole-level build's own rule for its band-by-band levels.
-        let m = super::stream::levels(&sizes, options);
+        let m = crate::mip::band::boxes::levels(&sizes, options);
         (m >= 1 && !options.normal_map).then_some((sizes, m))
     }
 
@@ -376,7 +380,7 @@ impl<'a> Streamer<'a> {
                     kept.copy_from_slice(cur);
                     break;
                 }
-                super::stream::reduce_band(cur, lw, lr, ch, straight, next);
+                crate::mip::band::boxes::reduce_band(cur, lw, lr, ch, straight, next);
                 std::mem::swap(cur, next);
                 (lw, lr) = (lw / 2, lr / 2);
             }
@@ -514,7 +518,7 @@ fn bandable_source(base: &Texture, out: Format) -> bool {
         && match base.channel_type() {
             ChannelType::U8 | ChannelType::U16 => true,
             ChannelType::F16 | ChannelType::F32 => {
-                out.channel_type.is_float() && super::nan::check(base).is_ok()
+                out.channel_type.is_float() && crate::mip::nan::check(base).is_ok()
             }
         }
 }
@@ -529,7 +533,7 @@ const BAND_ROWS: usize = 16;
 /// without a full-resolution f32 copy of level 0:
 /// - level 0 is decoded, alpha-associated and encoded into the output type
 ///   band by band ([`BAND_ROWS`] rows per band, in parallel);
-/// - level 1 is filtered band by band ([`super::separable::Reducer::band`]):
+/// - level 1 is filtered band by band ([`crate::mip::separable::Reducer::band`]):
 ///   each band decodes the level-0 rows its taps name (wrapped rows from
 ///   the far edge included), so bands meet exactly;
 /// - the rest of the chain is built from level 1 in f32 as before.
@@ -563,7 +567,7 @@ impl<'a> Banded<'a> {
         association: Option<AlphaMode>,
     ) -> std::result::Result<Self, Texture> {
         let (w, h) = (base.width() as usize, base.height() as usize);
-        let sizes = super::level_sizes(
+        let sizes = crate::mip::level_sizes(
             base.width(),
             base.height(),
             options.rounding,
@@ -639,7 +643,7 @@ impl<'a> Banded<'a> {
             crate::texel::decode_range_to_linear(&stored, base.texels(), j as usize * w * ch, row)
         };
         let (w1, h1) = (sizes[1].0 as usize, sizes[1].1 as usize);
-        let reducer = super::separable::Reducer::new(
+        let reducer = crate::mip::separable::Reducer::new(
             f32fmt, w as u32, h as u32, w1 as u32, h1 as u32, options,
         );
         // The fast row kernel whenever fast paths are on: the whole-image
@@ -771,28 +775,42 @@ pub(crate) struct Clipped {
     pub texels: u64,
 }
 
-/// The colour chain of `base` (read as `src`) stored as `out_format`:
-/// built in the source format when `same` (it is the output format),
-/// else band by band ([`Stream`]) where that applies, else in linear f32
-/// from a single decode of level 0 (see the module docs), each level's
-/// alpha association changed and converted to the output format once;
-/// with the texels clipped when float values went to a normalised output.
+/// How a colour chain is built, as the pipeline's plan chose it (the
+/// plan is the one place that decides; see `pipeline::BuildPath`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Route {
+    /// In the source's own format, the whole-level build.
+    Whole,
+    /// Level 0 decoded whole to linear f32, then the whole-level build.
+    Decoded,
+    /// Band by band, the 2×2 box of levels that halve exactly
+    /// ([`Streamer`]).
+    Streamed,
+    /// Band by band, the general filters ([`Banded`]).
+    Banded,
+}
+
+/// The colour chain of `base` (read as `src`) stored as `out_format`,
+/// built the way `route` says: in the source format
+/// ([`Route::Whole`], it is the output format), band by band, or in
+/// linear f32 from a single decode of level 0 (see the module docs); each
+/// level's alpha association changed and converted to the output format
+/// once, the texels counted when float values went to a normalised
+/// output and were clipped. A band route falls back to the decode only
+/// for a float source holding NaN or infinities (found as it is read).
 pub(crate) fn build_converted(
     base: Texture,
     options: &MipOptions,
     src: Format,
     out_format: Format,
     association: Option<AlphaMode>,
-    same: bool,
+    route: Route,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<(Vec<Texture>, Option<Clipped>)> {
-    let base = if same {
-        base
-    } else {
-        match Stream::new(base, options, src, out_format, association, None)? {
-            Ok(b) => return Ok((b.build_all(progress)?, None)),
-            Err(base) => base,
-        }
+    let same = route == Route::Whole;
+    let base = match Stream::new(base, options, src, out_format, association, route, None)? {
+        Ok(b) => return Ok((b.build_all(progress)?, None)),
+        Err(base) => base,
     };
     let work_base = if same {
         base
@@ -807,7 +825,7 @@ pub(crate) fn build_converted(
         drop(base);
         Texture::from_f32(w, h, f, linear)?
     };
-    let chain: MipChain = super::build_with_progress(work_base, options, progress)?;
+    let chain: MipChain = crate::mip::build_with_progress(work_base, options, progress)?;
     // Float data (HDR) written to a normalised type is clipped to [0, 1]:
     // count the texels that lose something, to say so once.
     let count_clipped = src.channel_type.is_float() && !out_format.channel_type.is_float();

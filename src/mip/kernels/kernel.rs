@@ -2,7 +2,7 @@
 //! (support in source texels at scale 1) and a pointwise evaluation.
 //!
 //! Box is special: its weights are the exact overlap areas of source texels
-//! with the destination footprint (see [`super::weights`]), which yields the
+//! with the destination footprint (see [`crate::mip::weights`]), which yields the
 //! 2×2 average for even sizes and the polyphase 3-tap box for odd sizes. Its
 //! `evaluate` is still provided so the interface is uniform.
 
