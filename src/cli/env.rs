@@ -79,6 +79,7 @@ fn sampler(
             )),
         }
     };
+    let placement = source.placement;
     match source.kind {
         ImageKind::LatLong => {
             // Without levels of its own, the levels a lat-long map needs
@@ -86,7 +87,9 @@ fn sampler(
             let levels = source.images.into_iter().next().unwrap_or_default();
             let chain = own(levels, &latlong::build_chain)?;
             Ok((
-                EnvSampler::LatLong(Box::new(LatLongSampler::new(&chain, options)?)),
+                EnvSampler::LatLong(Box::new(
+                    LatLongSampler::new(&chain, options)?.with_placement(placement),
+                )),
                 channels,
             ))
         }

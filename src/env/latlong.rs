@@ -29,7 +29,11 @@
 //!   level `m − 1` alone, `none` level 0.
 //! - Each level is read with the sampler's minification filter (OpenImageIO
 //!   has one interpolation mode for all levels): bilinear at
-//!   `(s·w − ½, t·h − ½)` or the nearest texel.
+//!   `(s·w − ½, t·h − ½)` or the nearest texel. A map placed as OpenEXR
+//!   defines it ([`Placement::Edges`], any OpenEXR file with an `envmap`
+//!   attribute) is read at `(s·(w − 1), t·(h − 1))` instead: its first and
+//!   last rows are the poles, its first and last columns one meridian, so
+//!   the lookup interpolates inside the image and never wraps or fades.
 //! - Near a pole, bilinear reads of the small levels fade to the pole's
 //!   colour (the mean of the level's first or last row), so the coarse
 //!   levels converge to one colour at the pole: with `tt = t·h`, weight
@@ -54,8 +58,8 @@ use crate::sample::{LinearChain, Method, MipMode, Query, Sampler, SamplerOptions
 use crate::texture::Texture;
 use crate::wrap::{Wrap, WrapMode};
 
-use super::DirQuery;
 use super::vec3::{add, unit};
+use super::{DirQuery, Placement};
 
 /// Levels at most this many texels wide and high fade to the pole colour
 /// near the poles (module docs).
@@ -88,6 +92,8 @@ pub struct LatLongSampler {
     plane: Option<Sampler>,
     /// Per level: the mean of its first and of its last row.
     poles: Vec<[[f32; 4]; 2]>,
+    /// Where the texels sit (the file's convention).
+    placement: Placement,
 }
 
 impl LatLongSampler {
@@ -132,7 +138,20 @@ impl LatLongSampler {
             options,
             plane,
             poles,
+            placement: Placement::Centred,
         })
+    }
+
+    /// This sampler reading its texels as `placement` places them (the
+    /// file's convention: [`crate::io::SourceInfo::placement`]).
+    pub fn with_placement(mut self, placement: Placement) -> Self {
+        self.placement = placement;
+        self
+    }
+
+    /// Where this sampler places the texels.
+    pub fn placement(&self) -> Placement {
+        self.placement
     }
 
     /// The options this sampler filters with.
@@ -146,7 +165,25 @@ impl LatLongSampler {
         let dx = q.ddx.map(f64::from);
         let dy = q.ddy.map(f64::from);
         if let Some(p) = &self.plane {
-            return p.sample(&st_query(d, dx, dy));
+            let mut q = st_query(d, dx, dy);
+            if self.placement == Placement::Edges {
+                // The 2-D sampler places texel i at (i + ½)/w: level 0's
+                // edge-placed texel i, at s = i/(w − 1), is found there by
+                // s' = (s·(w − 1) + ½)/w (exact on level 0; the smaller
+                // levels are a fraction of a texel off).
+                let (w, h) = self.chain.level_size(0).unwrap_or((1, 1));
+                let (fw, fh) = (w.max(2) as f32, h.max(2) as f32);
+                let (sx, sy) = ((fw - 1.0) / fw, (fh - 1.0) / fh);
+                q = Query::new(
+                    q.u * sx + 0.5 / fw,
+                    q.v * sy + 0.5 / fh,
+                    q.dudx * sx,
+                    q.dvdx * sy,
+                    q.dudy * sx,
+                    q.dvdy * sy,
+                );
+            }
+            return p.sample(&q);
         }
         if self.options.method == Method::Supersample {
             return self.supersample(q);
@@ -216,7 +253,12 @@ impl LatLongSampler {
         let mut pick = (count - 1, count - 1, 0.0);
         for m in 0..count {
             let h = self.chain.level_size(m).map_or(1, |(_, h)| h) as f64;
-            let ras = h * width / PI;
+            // Rows per π radians: h, or h − 1 between edge-placed rows.
+            let rows = match self.placement {
+                Placement::Centred => h,
+                Placement::Edges => (h - 1.0).max(1.0),
+            };
+            let ras = rows * width / PI;
             if ras <= 1.0 {
                 pick = if m == 0 {
                     (0, 0, 0.0)
@@ -237,6 +279,9 @@ impl LatLongSampler {
     fn read(&self, filter: TexelFilter, k: usize, s: f64, t: f64) -> [f32; 4] {
         let (w, h) = self.chain.level_size(k).unwrap_or((1, 1));
         let (w, h) = (w as i64, h as i64);
+        if self.placement == Placement::Edges {
+            return self.read_edges(filter, k, (w, h), s, t);
+        }
         let texel = |i: i64, j: i64| {
             self.chain
                 .texel(k, i.rem_euclid(w) as u32, j.clamp(0, h - 1) as u32)
@@ -266,6 +311,36 @@ impl LatLongSampler {
         };
         let p = pole.clamp(0.0, 1.0);
         mix(v, colour, (p * p) as f32)
+    }
+
+    /// Level `k` (`w`×`h`) at `(s, t)` with OpenEXR's placement: the
+    /// continuous texel position `(s·(w − 1), t·(h − 1))`
+    /// (`LatLongMap::pixelPosition`), read inside the image (the last
+    /// column is the first's meridian, the edge rows the poles).
+    fn read_edges(
+        &self,
+        filter: TexelFilter,
+        k: usize,
+        (w, h): (i64, i64),
+        s: f64,
+        t: f64,
+    ) -> [f32; 4] {
+        let texel = |i: i64, j: i64| {
+            self.chain
+                .texel(k, i.clamp(0, w - 1) as u32, j.clamp(0, h - 1) as u32)
+                .unwrap_or([0.0; 4])
+        };
+        let x = s.clamp(0.0, 1.0) * (w - 1) as f64;
+        let y = t.clamp(0.0, 1.0) * (h - 1) as f64;
+        if filter == TexelFilter::Nearest {
+            return texel(x.round() as i64, y.round() as i64);
+        }
+        let (x0, y0) = (x.floor(), y.floor());
+        let (a, b) = ((x - x0) as f32, (y - y0) as f32);
+        let (i, j) = (x0 as i64, y0 as i64);
+        let top = mix(texel(i, j), texel(i + 1, j), a);
+        let bottom = mix(texel(i, j + 1), texel(i + 1, j + 1), a);
+        mix(top, bottom, b)
     }
 
     /// The supersampled reference (module docs).

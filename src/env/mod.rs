@@ -33,6 +33,27 @@ use crate::error::{Error, Result};
 use crate::mip::MipChain;
 use crate::sample::{Query, Sampler, SamplerOptions};
 
+/// Where an environment map's texels sit on the sphere: the one thing
+/// OpenEXR's definition and the GPU's (and maketx's) disagree on besides
+/// the faces' orientation. The reader of a file says which
+/// ([`crate::io::SourceInfo::placement`]); a sampler follows it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Placement {
+    /// Texel centres at `((i + ½)/w, (j + ½)/h)` of the map's `(s, t)`:
+    /// the GL and Vulkan cube faces, maketx's `.tx` lat-long maps (and
+    /// OpenImageIO's `environment()` on them), and every image that
+    /// records no OpenEXR environment.
+    #[default]
+    Centred,
+    /// OpenEXR's definition (`ImfEnvmap.cpp`): texel `i` at
+    /// `i/(w − 1)`, so the first and last texel centres lie on the
+    /// map's edges. A lat-long map's first row is the +y pole, its last
+    /// the −y pole, and its first and last columns the same meridian (−z)
+    /// (`LatLongMap::latLong`, `pixelPosition`); OpenImageIO reads
+    /// OpenEXR environments this way too (`oiio:sampleborder` 1).
+    Edges,
+}
+
 /// A lookup by direction: the direction (any non-zero length) and its
 /// change per pixel along screen x (`ddx`) and y (`ddy`), as a shader
 /// gets them with `dFdx`/`dFdy` of the reflection vector.

@@ -133,6 +133,11 @@ pub struct SourceInfo {
     /// [`LoadOptions::environment`] asks to describe them; see
     /// [`EnvironmentMaps`]).
     pub environment: Option<Environment>,
+    /// Where the environment's texels sit on the sphere, as the file's
+    /// format defines it: [`crate::env::Placement::Edges`] for an OpenEXR
+    /// file with an `envmap` attribute (OpenEXR's `ImfEnvmap`, which
+    /// OpenImageIO follows on such files), else centred.
+    pub placement: crate::env::Placement,
     /// What kind of image the file holds: one 2-D image, an array, a
     /// cube map or an array of them (KTX2, DDS); [`Loaded::images`] holds
     /// the faces or layers after the first. Loaders set it only when
@@ -156,6 +161,7 @@ impl SourceInfo {
             blocks: None,
             color_stated: true,
             environment: None,
+            placement: crate::env::Placement::Centred,
             kind: crate::texture::ImageKind::Plain,
         }
     }

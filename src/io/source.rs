@@ -9,6 +9,7 @@
 //! the aspect), or a lat-long map.
 
 use super::{Environment, Loaded};
+use crate::env::Placement;
 use crate::env::cube::{CubeLayout, faces_from_strip, faces_in_layout, layouts_sentence};
 use crate::error::{Error, Result};
 use crate::texture::{ImageKind, Texture};
@@ -24,6 +25,10 @@ pub struct Source {
     /// stores them whole (a KTX2 or DDS cube map or array, a mip-mapped
     /// lat-long file); level 0 only for faces cut from a strip or a cross.
     pub images: Vec<Vec<Texture>>,
+    /// Where the texels sit on the sphere: the file's convention for an
+    /// environment it records ([`super::SourceInfo::placement`]), centred
+    /// for everything else.
+    pub placement: Placement,
 }
 
 impl Source {
@@ -54,9 +59,11 @@ pub fn interpret(loaded: Loaded, name: &str, hint: Option<Environment>) -> Resul
         return Ok(Source {
             kind,
             images: loaded.into_images(),
+            placement: Placement::Centred,
         });
     }
     let recorded = loaded.info.environment;
+    let placement = loaded.info.placement;
     match (recorded, hint) {
         (Some(Environment::Cube), _) => {
             let (w, h) = (loaded.base().width(), loaded.base().height());
@@ -69,9 +76,15 @@ pub fn interpret(loaded: Loaded, name: &str, hint: Option<Environment>) -> Resul
             })?;
             Ok(cube(faces))
         }
-        (Some(Environment::LatLong), _) | (None, Some(Environment::LatLong)) => Ok(Source {
+        (Some(Environment::LatLong), _) => Ok(Source {
             kind: ImageKind::LatLong,
             images: vec![loaded.levels],
+            placement,
+        }),
+        (None, Some(Environment::LatLong)) => Ok(Source {
+            kind: ImageKind::LatLong,
+            images: vec![loaded.levels],
+            placement: Placement::Centred,
         }),
         (None, Some(Environment::Cube)) => {
             let base = loaded.base();
@@ -88,6 +101,7 @@ pub fn interpret(loaded: Loaded, name: &str, hint: Option<Environment>) -> Resul
                 return Ok(Source {
                     kind: ImageKind::LatLong,
                     images: vec![loaded.levels],
+                    placement: Placement::Centred,
                 });
             }
             Err(Error::InvalidOption(format!(
@@ -99,6 +113,7 @@ pub fn interpret(loaded: Loaded, name: &str, hint: Option<Environment>) -> Resul
         (None, None) => Ok(Source {
             kind: ImageKind::Plain,
             images: vec![loaded.levels],
+            placement: Placement::Centred,
         }),
     }
 }
@@ -135,5 +150,6 @@ fn cube(faces: Vec<Texture>) -> Source {
     Source {
         kind: ImageKind::Cube,
         images: faces.into_iter().map(|f| vec![f]).collect(),
+        placement: Placement::Centred,
     }
 }

@@ -252,7 +252,7 @@ fn read(
             (source::from_faces(faces, &job.faces)?, notes, None)
         }
     };
-    let Source { kind, images } = source;
+    let Source { kind, images, .. } = source;
     let mut bases = Vec::with_capacity(images.len());
     let mut src = None;
     let read_s = t_read.elapsed().as_secs_f64();

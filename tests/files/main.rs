@@ -23,6 +23,7 @@ mod cli_tradeoff;
 #[cfg(feature = "encode")]
 mod compress;
 mod env_containers;
+mod env_openexr_conventions;
 mod fuzz_replay;
 mod interrupted_write_leaves_destination;
 mod io_corrupt_inputs;

@@ -304,6 +304,14 @@ pub fn load(path: &Path, limits: &Limits, options: &crate::io::LoadOptions) -> R
         // OpenEXR stores linear values by definition.
         color_stated: true,
         environment,
+        // OpenEXR's own environments (the `envmap` attribute) place their
+        // texels as ImfEnvmap.cpp defines; maketx's `textureformat` alone
+        // keeps maketx's centred texels.
+        placement: if header.own_attributes.environment_map.is_some() {
+            crate::env::Placement::Edges
+        } else {
+            crate::env::Placement::Centred
+        },
         // A cube-face environment stays one strip image here
         // (`environment` says what it is).
         kind: crate::texture::ImageKind::Plain,

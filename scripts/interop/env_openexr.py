@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""OpenEXR's own lat-long environment maps read as OpenEXR defines them
+(issue 52): `parvo sample FILE --direction` with bilinear level-0 lookups
+against a numpy implementation of ImfEnvmap.cpp's LatLongMap (latLong of a
+direction, pixelPosition on the data window: row 0 on the +y pole, the
+last row on -y, columns 0 and w-1 on the same meridian) read bilinearly
+with clamped indices as exrenvmap's EnvmapImage::sample reads it, and
+against OpenImageIO's environment() on the same file (which reads OpenEXR
+environments with `oiio:sampleborder` 1).
+
+The bar: the 99th percentile of the relative difference within 2e-3. The
+same lookups placed as maketx's .tx places texels (centres at (i + 1/2)/w),
+what parvo read before, are printed beside it to show the check can tell
+the two apart.
+"""
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import OpenImageIO as oiio
+
+sys.dont_write_bytecode = True
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import args, check, finish  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+FILES = ["WavyLinesLatLong.exr"]
+N = 3000
+BAR = 2e-3
+
+
+def imf_lat_long(d):
+    """LatLongMap::latLong(dir): (latitude, longitude)."""
+    x, y, z = d[:, 0], d[:, 1], d[:, 2]
+    r = np.sqrt(z * z + x * x)
+    length = np.sqrt(x * x + y * y + z * z)
+    lat = np.where(r < np.abs(y),
+                   np.arccos(np.clip(r / length, -1, 1)) * np.sign(y),
+                   np.arcsin(np.clip(y / length, -1, 1)))
+    lon = np.where((z == 0) & (x == 0), 0.0, np.arctan2(x, z))
+    return lat, lon
+
+
+def imf_pixel_position(d, w, h):
+    """LatLongMap::pixelPosition(dataWindow, latLong(dir)), window at (0, 0)."""
+    lat, lon = imf_lat_long(d)
+    return (lon / (-2 * math.pi) + 0.5) * (w - 1), (lat / -math.pi + 0.5) * (h - 1)
+
+
+def bilinear(img, px, py):
+    """EnvmapImage::sample: floor, weights, indices clamped to the image."""
+    h, w = img.shape[:2]
+    x1, y1 = np.floor(px), np.floor(py)
+    tx, ty = (px - x1)[:, None], (py - y1)[:, None]
+    X1 = np.clip(x1, 0, w - 1).astype(np.int64)
+    X2 = np.clip(x1 + 1, 0, w - 1).astype(np.int64)
+    Y1 = np.clip(y1, 0, h - 1).astype(np.int64)
+    Y2 = np.clip(y1 + 1, 0, h - 1).astype(np.int64)
+    return ((img[Y1, X1] * (1 - tx) + img[Y1, X2] * tx) * (1 - ty)
+            + (img[Y2, X1] * (1 - tx) + img[Y2, X2] * tx) * ty)
+
+
+def read_level0(path):
+    inp = oiio.ImageInput.open(str(path))
+    spec = inp.spec()
+    px = inp.read_image(0, 0, 0, 3, "float")
+    inp.close()
+    return np.asarray(px, dtype=np.float64).reshape(spec.height, spec.width, 3)
+
+
+def directions(rng, n):
+    z = rng.uniform(-1, 1, n)
+    phi = rng.uniform(0, 2 * math.pi, n)
+    r = np.sqrt(1 - z * z)
+    d = np.stack([r * np.cos(phi), z, r * np.sin(phi)], axis=1)
+    # The poles and the seam meridian (-z), where the conventions part most.
+    extra = np.array([[0, 1, 0], [0, -1, 0], [0, 0, -1], [0.3, 0.2, -1], [-0.3, 0.2, -1],
+                      [1e-4, 0.5, -1], [-1e-4, 0.5, -1]], dtype=np.float64)
+    return np.concatenate([d, extra])
+
+
+def parvo_lookup(parvo, path, d):
+    cmd = [parvo, "sample", str(path), "--color", "linear", "--direction",
+           "--filter", "bilinear", "--mip", "none"]
+    queries = np.concatenate([d, np.zeros((len(d), 6))], axis=1)
+    text = "\n".join(" ".join("%.9g" % x for x in row) for row in queries) + "\n"
+    r = subprocess.run(cmd, input=text, capture_output=True, text=True)
+    if r.returncode != 0:
+        return None, f"exit {r.returncode}: {r.stderr.strip()[:300]}"
+    return np.loadtxt(r.stdout.splitlines(), dtype=np.float64, ndmin=2)[:, :3], ""
+
+
+def oiio_lookup(path, d):
+    ts = oiio.TextureSystem()
+    opt = oiio.TextureOpt()
+    opt.interpmode = oiio.InterpMode.Bilinear
+    opt.mipmode = oiio.MipMode.NoMIP
+    out = np.zeros((len(d), 3))
+    for i, v in enumerate(d):
+        out[i] = ts.environment(str(path), opt, tuple(v), (0, 0, 0), (0, 0, 0), 3)
+    return out
+
+
+def rel(a, b):
+    return np.abs(a - b).max(axis=1) / np.maximum(np.abs(b).max(axis=1), 1.0)
+
+
+def main():
+    parvo, _venv, _work = args()
+    rng = np.random.default_rng(52)
+    for name in FILES:
+        path = ROOT / "tests/data/peer/openexr-images" / name
+        img = read_level0(path)
+        h, w = img.shape[:2]
+        d = directions(rng, N)
+        want = bilinear(img, *imf_pixel_position(d, w, h))
+        got, why = parvo_lookup(parvo, path, d)
+        if not check(got is not None, f"{name}: parvo sample --direction", why):
+            continue
+        e = rel(got, want)
+        # maketx's placement (texel centres at (i + 1/2)/w, s wrapping):
+        # what parvo read before, for scale.
+        lat, lon = imf_lat_long(d)
+        cx = np.mod((lon / (-2 * math.pi) + 0.5) * w - 0.5, w)
+        cy = (lat / -math.pi + 0.5) * h - 0.5
+        centred = rel(bilinear(img, cx, cy), want)
+        check(np.percentile(e, 99) <= BAR,
+              f"{name}: bilinear lookups equal ImfEnvmap's at the 99th percentile",
+              f"p99 {np.percentile(e, 99):.2e}, max {e.max():.2e} over {len(d)} directions; "
+              f"maketx's centred placement: p99 {np.percentile(centred, 99):.2e}")
+        ref = oiio_lookup(path, d)
+        eo = rel(got, ref)
+        check(np.percentile(eo, 99) <= BAR,
+              f"{name}: and OpenImageIO's environment() on the file",
+              f"p99 {np.percentile(eo, 99):.2e}, max {eo.max():.2e}")
+    finish()
+
+
+if __name__ == "__main__":
+    main()
