@@ -113,7 +113,7 @@ fn sampler(
                 )?
             };
             Ok((
-                EnvSampler::Cube(CubeSampler::new(&chains, options)?),
+                EnvSampler::Cube(CubeSampler::new(&chains, options)?.with_placement(placement)),
                 channels,
             ))
         }

@@ -37,7 +37,7 @@ use crate::texel::Texels;
 use crate::texture::Texture;
 use crate::wrap::{Wrap, WrapMode};
 
-use super::DirQuery;
+use super::{DirQuery, Placement};
 
 /// The six faces in GL's order: +X, −X, +Y, −Y, +Z, −Z (KTX2's, DDS's and
 /// Vulkan's order too).
@@ -179,6 +179,8 @@ pub struct CubeSampler {
     options: SamplerOptions,
     /// Level-0 face size.
     size: u32,
+    /// Where the texels sit on each face.
+    placement: Placement,
 }
 
 impl CubeSampler {
@@ -198,7 +200,25 @@ impl CubeSampler {
             faces: faces.iter().map(LinearChain::new).collect(),
             options,
             size: faces[0].levels()[0].width(),
+            placement: Placement::Centred,
         })
+    }
+
+    /// This sampler reading its faces' texels as `placement` places them:
+    /// [`Placement::Edges`] for OpenEXR's cube maps, whose outermost texel
+    /// centres lie on the cube's edges (`CubeMap::faceAndPixelPosition`
+    /// scales by `sof − 1`), so a nearest or bilinear lookup reads face
+    /// `f` alone, at `(s·(n − 1), t·(n − 1))`, and the edge texels it
+    /// shares with the next face hold the same values. The EWA filter
+    /// and the footprint keep GL's centres (a fraction of a texel apart).
+    pub fn with_placement(mut self, placement: Placement) -> Self {
+        self.placement = placement;
+        self
+    }
+
+    /// Where this sampler places the texels.
+    pub fn placement(&self) -> Placement {
+        self.placement
     }
 
     /// The options this sampler filters with.
@@ -307,6 +327,10 @@ impl CubeSampler {
     /// the face: the position is on it).
     pub(crate) fn nearest(&self, f: usize, k: usize, s: f64, t: f64) -> [f32; 4] {
         let n = self.level_size(k);
+        if self.placement == Placement::Edges {
+            let idx = |x: f64| ((x * (n - 1) as f64).round() as i64).clamp(0, n - 1);
+            return self.stored(f, k, idx(s), idx(t));
+        }
         let idx = |x: f64| ((x * n as f64).floor() as i64).clamp(0, n - 1);
         self.texel(f, k, idx(s), idx(t))
     }
@@ -314,6 +338,9 @@ impl CubeSampler {
     /// Bilinear lookup at `(s, t)` of face `f`, level `k`, reading across
     /// edges (GL: i0 = ⌊s·n − ½⌋, α its fraction).
     pub(crate) fn bilinear(&self, f: usize, k: usize, s: f64, t: f64) -> [f32; 4] {
+        if self.placement == Placement::Edges {
+            return self.bilinear_edges(f, k, s, t);
+        }
         let n = self.level_size(k) as f64;
         let (x, y) = (s * n - 0.5, t * n - 0.5);
         let (x0, y0) = (x.floor(), y.floor());
@@ -324,6 +351,24 @@ impl CubeSampler {
         let t01 = self.texel(f, k, i, j + 1);
         let t11 = self.texel(f, k, i + 1, j + 1);
         lerp(lerp(t00, t10, a), lerp(t01, t11, a), b)
+    }
+
+    /// Bilinear with OpenEXR's placement: at `(s·(n − 1), t·(n − 1))` on
+    /// face `f` alone, indices clamped to it (the position never leaves
+    /// the face, and the edge texels are the neighbour's too).
+    fn bilinear_edges(&self, f: usize, k: usize, s: f64, t: f64) -> [f32; 4] {
+        let n = self.level_size(k);
+        let m = (n - 1) as f64;
+        let (x, y) = (s.clamp(0.0, 1.0) * m, t.clamp(0.0, 1.0) * m);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (a, b) = ((x - x0) as f32, (y - y0) as f32);
+        let (i, j) = (x0 as i64, y0 as i64);
+        let at = |i: i64, j: i64| self.stored(f, k, i.clamp(0, n - 1), j.clamp(0, n - 1));
+        lerp(
+            lerp(at(i, j), at(i + 1, j), a),
+            lerp(at(i, j + 1), at(i + 1, j + 1), a),
+            b,
+        )
     }
 
     /// Texel `(i, j)` of face `f`, level `k`, seamless (module docs): `i`

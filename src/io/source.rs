@@ -67,14 +67,23 @@ pub fn interpret(loaded: Loaded, name: &str, hint: Option<Environment>) -> Resul
     match (recorded, hint) {
         (Some(Environment::Cube), _) => {
             let (w, h) = (loaded.base().width(), loaded.base().height());
-            let faces = faces_from_strip(loaded.base()).map_err(|_| {
+            let strip = faces_from_strip(loaded.base()).map_err(|_| {
                 Error::InvalidOption(format!(
                     "`{name}` is a cube-face environment map of {w}x{h}, which parvo reads \
                      only as OpenEXR's vertical strip of six square faces (w x 6w, +x -x +y -y \
                      +z -z from the top)"
                 ))
             })?;
-            Ok(cube(faces))
+            // OpenEXR's own cube (its `envmap` attribute) holds OpenEXR's
+            // faces; maketx's `textureformat` alone, GL's.
+            if placement == Placement::Edges {
+                let faces = super::exr::mirror_cube_faces(&strip)?;
+                return Ok(Source {
+                    placement,
+                    ..cube(faces)
+                });
+            }
+            Ok(cube(strip))
         }
         (Some(Environment::LatLong), _) => Ok(Source {
             kind: ImageKind::LatLong,

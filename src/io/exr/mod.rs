@@ -303,6 +303,22 @@ impl super::Container for OpenExr {
     }
 }
 
+/// OpenEXR's cube faces (`ImfEnvmap.cpp`, `CubeMap::pixelPosition`) as
+/// GL's faces of the same directions, or GL's as OpenEXR's: the same face
+/// order (+X, −X, +Y, −Y, +Z, −Z), each face mirrored: the X and Z faces
+/// left to right, the Y faces top to bottom (OpenEXR's +X face has +z to
+/// the right and −y down, GL's −z to the right and −y down; its +Y face
+/// +x right and −z down, GL's +x right and +z down). The mirror is its own
+/// inverse. Texel placement is a separate matter
+/// ([`crate::env::Placement`]).
+pub fn mirror_cube_faces(faces: &[Texture]) -> Result<Vec<Texture>> {
+    faces
+        .iter()
+        .enumerate()
+        .map(|(f, t)| super::orient(t, if f == 2 || f == 3 { 4 } else { 2 }))
+        .collect()
+}
+
 /// The levels of OpenEXR's cube-map strip for six faces' levels: level k
 /// stacks the faces' level k while they are at least 1×1; the strip's
 /// last levels (1×3, 1×1), which OpenEXR's level rule asks for but no
@@ -310,10 +326,12 @@ impl super::Container for OpenExr {
 /// is not a power of two cannot keep apart in the strip's levels.
 fn cube_strip_levels(faces: &[&[Texture]], rounding: Rounding) -> Result<Vec<Texture>> {
     let n = faces[0][0].width();
+    // GL's faces (parvo's order and orientation) as OpenEXR's.
     let mut strip: Vec<Texture> = (0..faces[0].len())
         .map(|k| {
-            let level: Vec<&Texture> = faces.iter().map(|f| &f[k]).collect();
-            crate::env::cube::strip_from_faces(&level)
+            let level: Vec<Texture> = faces.iter().map(|f| f[k].clone()).collect();
+            let level = mirror_cube_faces(&level)?;
+            crate::env::cube::strip_from_faces(&level.iter().collect::<Vec<_>>())
         })
         .collect::<Result<_>>()?;
     if strip.len() == 1 {
