@@ -102,7 +102,9 @@ pub mod wrap;
 
 pub use error::{Error, Result};
 pub use mip::{MipChain, MipFilter, MipOptions, NanPolicy, Rounding};
-pub use sample::{Filter, Query, Sampler, SamplerOptions, TexelSink};
+pub use sample::{
+    CompareOp, Filter, Method, MipMode, Query, Sampler, SamplerOptions, TexelFilter, TexelSink,
+};
 pub use sat::{AccumulatorKind, SatSampler, SummedAreaTable};
 pub use texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 pub use texture::{ImageKind, Texture};

@@ -14,19 +14,19 @@ use std::fmt;
 /// A setting a library message names (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Setting {
-    /// [`crate::io::Limits::max_width`].
+    /// `io::Limits::max_width`.
     MaxWidth,
-    /// [`crate::io::Limits::max_height`].
+    /// `io::Limits::max_height`.
     MaxHeight,
-    /// [`crate::io::Limits::max_alloc`].
+    /// `io::Limits::max_alloc`.
     MaxAlloc,
-    /// [`crate::io::LoadOptions::channels`].
+    /// `io::LoadOptions::channels`.
     Channels,
-    /// [`crate::io::LoadOptions::subimage`].
+    /// `io::LoadOptions::subimage`.
     Subimage,
-    /// [`crate::io::LoadOptions::color`].
+    /// `io::LoadOptions::color`.
     Color,
-    /// [`crate::io::LoadOptions::auto_orient`] set to false.
+    /// `io::LoadOptions::auto_orient` set to false.
     NoAutoOrient,
     /// [`crate::mip::MipOptions::wrap`].
     Wrap,

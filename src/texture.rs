@@ -13,7 +13,7 @@ use crate::texel::{self, AlphaMode, ChannelType, Format, Texels};
 /// What kind of image a texture is: the shape a file's images make (a
 /// 2-D texture, an array of them, a cube map, an array of cube maps, or a
 /// 2-D image holding a lat-long environment). Every loader reports it
-/// ([`crate::io::SourceInfo::kind`]), every container says which it
+/// (`io::SourceInfo::kind`), every container says which it
 /// stores, and the mip pipeline builds each by its own rule.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum ImageKind {

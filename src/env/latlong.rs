@@ -143,7 +143,7 @@ impl LatLongSampler {
     }
 
     /// This sampler reading its texels as `placement` places them (the
-    /// file's convention: [`crate::io::SourceInfo::placement`]).
+    /// file's convention: `io::SourceInfo::placement`).
     pub fn with_placement(mut self, placement: Placement) -> Self {
         self.placement = placement;
         self

@@ -36,7 +36,7 @@ use crate::sample::{Query, Sampler, SamplerOptions};
 /// Where an environment map's texels sit on the sphere: the one thing
 /// OpenEXR's definition and the GPU's (and maketx's) disagree on besides
 /// the faces' orientation. The reader of a file says which
-/// ([`crate::io::SourceInfo::placement`]); a sampler follows it.
+/// (`io::SourceInfo::placement`); a sampler follows it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Placement {
     /// Texel centres at `((i + ½)/w, (j + ½)/h)` of the map's `(s, t)`:
@@ -87,7 +87,8 @@ impl DirQuery {
 /// The supersampled reference by direction, shared by the cube and
 /// lat-long samplers: the mean of `lookup` at `n × n` directions over the
 /// footprint `dir ± ddx/2 ± ddy/2`, one at the centre of each cell of the
-/// 2-D reference's grid (summed in `f64`).
+/// 2-D reference's grid (summed in `f64`; non-finite derivative components
+/// count as 0).
 pub(crate) fn grid_average(
     q: &DirQuery,
     n: u32,
@@ -95,11 +96,10 @@ pub(crate) fn grid_average(
 ) -> [f32; 4] {
     let n = n.clamp(1, 64);
     let inv = 1.0 / n as f64;
-    let (d, dx, dy) = (
-        q.dir.map(f64::from),
-        q.ddx.map(f64::from),
-        q.ddy.map(f64::from),
-    );
+    // A NaN or infinite derivative component spans nothing (as the 2-D
+    // samplers take it): the grid stays finite, so every lookup does.
+    let finite = |v: [f32; 3]| v.map(|x| if x.is_finite() { f64::from(x) } else { 0.0 });
+    let (d, dx, dy) = (q.dir.map(f64::from), finite(q.ddx), finite(q.ddy));
     let mut acc = [0.0f64; 4];
     for j in 0..n {
         let ty = (j as f64 + 0.5) * inv - 0.5;

@@ -1,14 +1,18 @@
 //! Block compression of a built chain: the encode on all threads, its
 //! figures, and what a block format does that the user should hear of.
 
+#[cfg(feature = "encode")]
 use std::time::Instant;
 
+#[cfg(feature = "encode")]
 use rayon::prelude::*;
 
 use super::{Note, Stage};
 use crate::compress::{BlockChain, BlockFormat, Quality};
 use crate::error::{Error, Result};
-use crate::texel::{AlphaMode, ColorSpace, Format};
+#[cfg(feature = "encode")]
+use crate::texel::AlphaMode;
+use crate::texel::{ColorSpace, Format};
 use crate::texture::Texture;
 
 /// Per-level figures of a block-compressed output.
