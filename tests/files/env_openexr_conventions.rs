@@ -64,35 +64,60 @@ fn imf_pixel_position(w: u32, h: u32, (lat, lon): (f64, f64)) -> (f64, f64) {
     (x * (w - 1) as f64, y * (h - 1) as f64)
 }
 
-/// Bilinear at a continuous pixel position, indices clamped to the image
-/// (as exrenvmap's `EnvmapImage::filteredLookup` clamps them).
-fn bilinear(t: &Texture, (x, y): (f64, f64)) -> [f64; 4] {
-    let (w, h) = (t.width() as i64, t.height() as i64);
-    let lin = t.to_linear();
-    let ch = t.format().channels as usize;
-    let texel = |i: i64, j: i64| {
-        let (i, j) = (i.clamp(0, w - 1) as usize, j.clamp(0, h - 1) as usize);
-        let at = (j * w as usize + i) * ch;
-        let mut v = [0.0, 0.0, 0.0, 1.0];
-        for c in 0..ch.min(4) {
-            v[c] = lin[at + c] as f64;
+/// An image's texels in linear `f64` RGBA, converted once.
+struct Linear {
+    w: i64,
+    texels: Vec<[f64; 4]>,
+}
+
+impl Linear {
+    fn of(t: &Texture) -> Linear {
+        let ch = t.format().channels as usize;
+        let texels = t
+            .to_linear()
+            .chunks(ch)
+            .map(|p| {
+                let mut v = [0.0, 0.0, 0.0, 1.0];
+                for c in 0..ch.min(4) {
+                    v[c] = p[c] as f64;
+                }
+                v
+            })
+            .collect();
+        Linear {
+            w: t.width() as i64,
+            texels,
         }
-        v
-    };
-    let (x0, y0) = (x.floor(), y.floor());
-    let (a, b) = (x - x0, y - y0);
-    let (i, j) = (x0 as i64, y0 as i64);
-    let (t00, t10, t01, t11) = (
-        texel(i, j),
-        texel(i + 1, j),
-        texel(i, j + 1),
-        texel(i + 1, j + 1),
-    );
-    std::array::from_fn(|c| {
-        let top = t00[c] * (1.0 - a) + t10[c] * a;
-        let bottom = t01[c] * (1.0 - a) + t11[c] * a;
-        top * (1.0 - b) + bottom * b
-    })
+    }
+
+    /// Bilinear at a continuous pixel position, column indices clamped to
+    /// the image and row indices to `rows` (as exrenvmap's
+    /// `EnvmapImage::sample` clamps them: the whole image for a lat-long
+    /// map, one face's rows for a cube strip).
+    fn bilinear(&self, (x, y): (f64, f64), (lo, hi): (i64, i64)) -> [f64; 4] {
+        let texel = |i: i64, j: i64| {
+            self.texels[(j.clamp(lo, hi) * self.w + i.clamp(0, self.w - 1)) as usize]
+        };
+        let (x0, y0) = (x.floor(), y.floor());
+        let (a, b) = (x - x0, y - y0);
+        let (i, j) = (x0 as i64, y0 as i64);
+        let (t00, t10, t01, t11) = (
+            texel(i, j),
+            texel(i + 1, j),
+            texel(i, j + 1),
+            texel(i + 1, j + 1),
+        );
+        std::array::from_fn(|c| {
+            let top = t00[c] * (1.0 - a) + t10[c] * a;
+            let bottom = t01[c] * (1.0 - a) + t11[c] * a;
+            top * (1.0 - b) + bottom * b
+        })
+    }
+
+    /// All rows.
+    fn rows(&self) -> (i64, i64) {
+        (0, self.texels.len() as i64 / self.w - 1)
+    }
 }
 
 /// Directions over the whole sphere, fixed seed, the poles and the seam
@@ -152,9 +177,10 @@ fn openexr_lat_long_lookups_equal_imf_envmap() {
         .unwrap()
         .with_placement(source.placement);
     let (w, h) = (base.width(), base.height());
+    let image = Linear::of(&base);
     let mut worst = 0.0f64;
     for d in directions(2000) {
-        let want = bilinear(&base, imf_pixel_position(w, h, imf_lat_long(d)));
+        let want = image.bilinear(imf_pixel_position(w, h, imf_lat_long(d)), image.rows());
         let got = sampler.sample(&DirQuery::point(d.map(|c| c as f32)));
         for c in 0..4 {
             let err = (got[c] as f64 - want[c]).abs() / want[c].abs().max(1.0);
@@ -176,9 +202,10 @@ fn the_centred_placement_is_not_openexr_s() {
     let chain = latlong::build_chain(base.clone()).unwrap();
     let centred = LatLongSampler::new(&chain, level0_bilinear()).unwrap();
     let (w, h) = (base.width(), base.height());
+    let image = Linear::of(&base);
     let mut worst = 0.0f64;
     for d in directions(2000) {
-        let want = bilinear(&base, imf_pixel_position(w, h, imf_lat_long(d)));
+        let want = image.bilinear(imf_pixel_position(w, h, imf_lat_long(d)), image.rows());
         let got = centred.sample(&DirQuery::point(d.map(|c| c as f32)));
         for c in 0..3 {
             worst = worst.max((got[c] as f64 - want[c]).abs() / want[c].abs().max(1.0));
@@ -227,38 +254,6 @@ fn imf_cube_pixel(d: [f64; 3], sof: u32) -> (usize, (f64, f64)) {
     (face, pos)
 }
 
-/// Bilinear in the strip at `(x, y)`, indices clamped to face `face`'s
-/// rows (the position never leaves the face).
-fn bilinear_in_face(strip: &Texture, face: usize, (x, y): (f64, f64)) -> [f64; 4] {
-    let sof = strip.width() as i64;
-    let lin = strip.to_linear();
-    let ch = strip.format().channels as usize;
-    let texel = |i: i64, j: i64| {
-        let i = i.clamp(0, sof - 1) as usize;
-        let j = j.clamp(face as i64 * sof, face as i64 * sof + sof - 1) as usize;
-        let at = (j * sof as usize + i) * ch;
-        let mut v = [0.0, 0.0, 0.0, 1.0];
-        for c in 0..ch.min(4) {
-            v[c] = lin[at + c] as f64;
-        }
-        v
-    };
-    let (x0, y0) = (x.floor(), y.floor());
-    let (a, b) = (x - x0, y - y0);
-    let (i, j) = (x0 as i64, y0 as i64);
-    let (t00, t10, t01, t11) = (
-        texel(i, j),
-        texel(i + 1, j),
-        texel(i, j + 1),
-        texel(i + 1, j + 1),
-    );
-    std::array::from_fn(|c| {
-        let top = t00[c] * (1.0 - a) + t10[c] * a;
-        let bottom = t01[c] * (1.0 - a) + t11[c] * a;
-        top * (1.0 - b) + bottom * b
-    })
-}
-
 /// A cube sampler over level 0 of `faces` (GL's order and orientation).
 fn cube_sampler(faces: &[Vec<Texture>], placement: Placement) -> CubeSampler {
     let chains: Vec<MipChain> = faces
@@ -282,10 +277,12 @@ fn openexr_cube_lookups_equal_imf_envmap() {
     assert_eq!(source.placement, Placement::Edges);
     let sampler = cube_sampler(&source.images, source.placement);
     let sof = strip.width();
+    let image = Linear::of(&strip);
     let mut worst = 0.0f64;
     for d in directions(2000) {
         let (face, pos) = imf_cube_pixel(d, sof);
-        let want = bilinear_in_face(&strip, face, pos);
+        let first = (face as u32 * sof) as i64;
+        let want = image.bilinear(pos, (first, first + sof as i64 - 1));
         let got = sampler.sample(&DirQuery::point(d.map(|c| c as f32)));
         for c in 0..4 {
             worst = worst.max((got[c] as f64 - want[c]).abs() / want[c].abs().max(1.0));
