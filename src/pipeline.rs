@@ -212,6 +212,54 @@ pub struct Outcome {
     pub image_kind: ImageKind,
     /// How the job was (or, in a dry run, would be) built and written.
     pub plan: Plan,
+    /// What the lighting options of an environment job computed
+    /// (`--prefilter`, `--irradiance`), else `None`.
+    pub lighting: Option<Lighting>,
+}
+
+/// What the lighting options of an environment job computed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lighting {
+    /// The prefilter's lobe and each level's roughness α, level 0 first
+    /// ([`crate::env::prefilter::alpha`]), when levels are prefiltered.
+    pub roughness: Option<(crate::env::prefilter::Lobe, Vec<f64>)>,
+    /// The environment's 9 spherical-harmonic coefficients per RGB
+    /// channel ([`crate::env::prefilter::sh9`]), from its level 0; `None`
+    /// in a dry run and for an up-to-date output.
+    pub sh9: Option<[[f64; 3]; 9]>,
+}
+
+/// The [`Lighting`] a job of settings `s` and `plan` reports before its
+/// levels are built (the roughness of prefiltered levels; no SH9 yet), or
+/// `None` when it asks for no lighting.
+fn lighting(s: &Settings, plan: &Plan) -> Option<Lighting> {
+    if s.env.prefilter.is_none() && s.env.irradiance.is_none() {
+        return None;
+    }
+    let levels = plan.level_sizes.len();
+    Some(Lighting {
+        roughness: s.env.prefilter.map(|(lobe, _)| {
+            let a = (0..levels)
+                .map(|k| crate::env::prefilter::alpha(k, levels))
+                .collect();
+            (lobe, a)
+        }),
+        sh9: None,
+    })
+}
+
+impl Lighting {
+    /// The roughness list as the output's `parvo:roughness` attribute
+    /// (KTX2 key/value, OpenEXR attribute) holds it: α per level, level 0
+    /// first, separated by spaces.
+    pub fn roughness_text(&self) -> Option<String> {
+        self.roughness.as_ref().map(|(_, a)| {
+            a.iter()
+                .map(|a| (*a as f32).to_string())
+                .collect::<Vec<_>>()
+                .join(" ")
+        })
+    }
 }
 
 /// Something the loader or the build did that the user would not assume.
@@ -436,6 +484,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         block_format: s.compress.map(|(bf, _)| block_label(bf, out_format)),
         image_kind: ImageKind::Plain,
         plan: plan.clone(),
+        lighting: None,
     };
     if s.dry_run {
         return Ok(outcome(Status::DryRun, &input));
@@ -471,17 +520,26 @@ fn save_options(
     fingerprint: String,
     channel_names: Option<Vec<String>>,
 ) -> SaveOptions {
+    let mut attributes = vec![
+        ("parvo:filter".into(), s.filter.to_string()),
+        ("parvo:source".into(), src.to_string()),
+        ("parvo:rounding".into(), s.rounding.to_string()),
+    ];
+    if let Some((lobe, how)) = s.env.prefilter {
+        let text = lighting(s, plan).and_then(|l| l.roughness_text());
+        attributes.push((
+            "parvo:prefilter".into(),
+            format!("{} {}", lobe.name(), how.describe()),
+        ));
+        attributes.extend(text.map(|t| ("parvo:roughness".into(), t)));
+    }
     SaveOptions {
         channel_names,
         wrap: plan.options.wrap,
         exr: s.exr,
         fingerprint: Some(fingerprint),
         ktx2: s.ktx2,
-        attributes: vec![
-            ("parvo:filter".into(), s.filter.to_string()),
-            ("parvo:source".into(), src.to_string()),
-            ("parvo:rounding".into(), s.rounding.to_string()),
-        ],
+        attributes,
     }
 }
 

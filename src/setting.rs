@@ -50,6 +50,8 @@ pub enum Setting {
     Prefilter,
     /// The irradiance output (`pipeline::EnvSettings::irradiance`).
     Irradiance,
+    /// The split-sum BRDF table output (`pipeline::EnvSettings::brdf_lut`).
+    BrdfLut,
     /// Cube faces' size (`pipeline::EnvSettings::face_size`).
     FaceSize,
     /// Cube faces' edges left as filtered
@@ -59,7 +61,7 @@ pub enum Setting {
 
 impl Setting {
     /// Every setting.
-    pub const ALL: [Setting; 20] = [
+    pub const ALL: [Setting; 21] = [
         Setting::MaxWidth,
         Setting::MaxHeight,
         Setting::MaxAlloc,
@@ -78,6 +80,7 @@ impl Setting {
         Setting::Environment,
         Setting::Prefilter,
         Setting::Irradiance,
+        Setting::BrdfLut,
         Setting::FaceSize,
         Setting::NoEdgeFixup,
     ];
@@ -103,6 +106,7 @@ impl Setting {
             Setting::Environment => "EnvSettings::target",
             Setting::Prefilter => "EnvSettings::prefilter",
             Setting::Irradiance => "EnvSettings::irradiance",
+            Setting::BrdfLut => "EnvSettings::brdf_lut",
             Setting::FaceSize => "EnvSettings::face_size",
             Setting::NoEdgeFixup => "EnvSettings::edge_fixup=false",
         }

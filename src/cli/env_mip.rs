@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use parvo::env::prefilter::Lobe;
+use parvo::env::prefilter::{Integration, Lobe};
 use parvo::io::{Environment, OutputKind};
 use parvo::pipeline::EnvSettings;
 
@@ -70,20 +70,31 @@ pub struct EnvMipArgs {
         long_help = "Write prefiltered specular levels instead of a plain chain (cube maps): level k \
         holds the environment convolved with the lobe (ggx, beckmann or phong) of roughness alpha_k \
         = (k / (L - 1))^2 over the L levels, with the split-sum convention N = V = R (Karis 2013), \
-        by filtered importance sampling (--prefilter-samples directions per texel, each read from \
-        the level whose texels match the sample's solid angle). Levels are linear f32 RGBA \
+        integrated over level 0's texels by a deterministic quadrature (each texel's exact solid \
+        angle; blocks of texels summed whole where the lobe is flat across them), or by filtered \
+        importance sampling with --prefilter-samples. Levels are linear f32 RGBA \
         internally; written as --type, else f16 (f32 for f32 inputs) where the container stores \
         floats."
     )]
     pub prefilter: Option<LobeArg>,
 
-    /// Lobe directions per texel for --prefilter.
-    #[arg(long, default_value_t = 64, value_name = "N", requires = "prefilter")]
-    pub prefilter_samples: u32,
+    /// Prefilter by filtered importance sampling with N lobe directions per texel (as cmgen does)
+    /// instead of the quadrature.
+    #[arg(long, value_name = "N", requires = "prefilter")]
+    pub prefilter_samples: Option<u32>,
 
     /// Also write the diffuse irradiance (cosine lobe) as a cube map of 32x32 faces to this file.
     #[arg(long, value_name = "OUTPUT")]
     pub irradiance: Option<PathBuf>,
+
+    /// Also write GGX's split-sum BRDF table (R scale, G bias of F0; n.v across, roughness down)
+    /// to this file (with --prefilter ggx).
+    #[arg(long, value_name = "OUTPUT")]
+    pub brdf_lut: Option<PathBuf>,
+
+    /// The BRDF table's size.
+    #[arg(long, value_name = "N", default_value_t = 128, requires = "brdf_lut")]
+    pub brdf_lut_size: u32,
 
     /// Keep each cube face's levels as filtered, without averaging the texels along the edges.
     #[arg(long)]
@@ -91,13 +102,27 @@ pub struct EnvMipArgs {
 }
 
 impl EnvMipArgs {
+    /// How `--prefilter` integrates its lobe.
+    fn integration(&self) -> Integration {
+        match self.prefilter_samples {
+            Some(n) => Integration::Sampled(n),
+            None => Integration::Quadrature,
+        }
+    }
+
     /// The library's environment settings of these arguments (a bad
     /// irradiance output name as text).
     pub fn settings(&self) -> Result<EnvSettings, String> {
+        let kind = |p: &PathBuf| OutputKind::from_path(p).map_err(|e| e.to_string());
         let irradiance = match &self.irradiance {
+            Some(p) => Some((p.clone(), kind(p)?)),
+            None => None,
+        };
+        let brdf_lut = match &self.brdf_lut {
             Some(p) => Some((
                 p.clone(),
-                OutputKind::from_path(p).map_err(|e| e.to_string())?,
+                OutputKind::for_one_level(p).map_err(|e| e.to_string())?,
+                self.brdf_lut_size,
             )),
             None => None,
         };
@@ -107,10 +132,9 @@ impl EnvMipArgs {
                 EnvArg::Cube => Environment::Cube,
             }),
             face_size: self.face_size,
-            prefilter: self
-                .prefilter
-                .map(|l| (Lobe::from(l), self.prefilter_samples)),
+            prefilter: self.prefilter.map(|l| (Lobe::from(l), self.integration())),
             irradiance,
+            brdf_lut,
             edge_fixup: !self.no_edge_fixup,
         })
     }

@@ -902,6 +902,11 @@ fn json_line(job: &Job, o: &Outcome, secs: f64) -> String {
             })).collect::<Vec<_>>(),
         })),
         "notes": o.notes.iter().map(note_text).collect::<Vec<_>>(),
+        "lighting": o.lighting.as_ref().map(|l| serde_json::json!({
+            "prefilter": l.roughness.as_ref().map(|(lobe, _)| lobe.name()),
+            "roughness": l.roughness.as_ref().map(|(_, a)| a),
+            "sh9": l.sh9,
+        })),
         "plan": {
             "path": format!("{:?}", o.plan.path),
             "memory_estimate_bytes": o.plan.memory_bytes,

@@ -27,6 +27,7 @@ pub(crate) fn flag(s: parvo::setting::Setting) -> &'static str {
         Setting::Environment => "--env",
         Setting::Prefilter => "--prefilter",
         Setting::Irradiance => "--irradiance",
+        Setting::BrdfLut => "--brdf-lut",
         Setting::FaceSize => "--face-size",
         Setting::NoEdgeFixup => "--no-edge-fixup",
     }

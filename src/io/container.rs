@@ -335,6 +335,19 @@ impl OutputKind {
         outputs().find(|k| k.id() == id)
     }
 
+    /// The container for an output of one level of one image: as
+    /// [`OutputKind::from_path`], and a `.png` name without `{level}` is
+    /// that one PNG.
+    pub fn for_one_level(path: &Path) -> Result<Self> {
+        let png = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if png {
+            return Ok(OutputKind::PNG_LEVELS);
+        }
+        OutputKind::from_path(path)
+    }
+
     /// Pick the container for an output name: `{level}` in the name means
     /// one file per level, otherwise the extension decides.
     pub fn from_path(path: &Path) -> Result<Self> {

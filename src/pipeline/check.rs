@@ -8,6 +8,7 @@ use std::path::PathBuf;
 
 use super::{Job, RoughnessSettings, RoughnessSource, Settings};
 use crate::compress::BlockFormat;
+use crate::env::prefilter::Lobe;
 use crate::error::{Error, Result};
 use crate::io::ktx2::Supercompression;
 use crate::io::{Environment, OutputKind};
@@ -126,8 +127,11 @@ pub enum Usage {
     PrefilterNeedsCube,
     /// An irradiance output of an input that is no environment.
     IrradianceNeedsEnvironment,
-    /// An irradiance output (one file) with more than one job.
-    IrradianceOfBatch,
+    /// An output of one file beside the job's (`--irradiance`,
+    /// `--brdf-lut`) with more than one job.
+    OneFileOfBatch(Setting),
+    /// A BRDF table beside levels that are not prefiltered with GGX.
+    BrdfLutNeedsGgx,
 }
 
 impl fmt::Display for Usage {
@@ -275,10 +279,15 @@ impl Usage {
                 Setting::Irradiance,
                 Setting::Environment
             ),
-            Usage::IrradianceOfBatch => write!(
+            Usage::OneFileOfBatch(setting) => {
+                write!(f, "{setting} names one file: use it with one input")
+            }
+            Usage::BrdfLutNeedsGgx => write!(
                 f,
-                "{} names one file: use it with one input",
-                Setting::Irradiance
+                "{} is the table of GGX's split sum, which pairs with levels prefiltered with \
+                 GGX: set {} to GGX",
+                Setting::BrdfLut,
+                Setting::Prefilter
             ),
             _ => Ok(()),
         }
@@ -405,7 +414,13 @@ fn check_env(jobs: &[Job], s: &Settings) -> Result<()> {
         return bad(Usage::PrefilterNeedsCube);
     }
     if e.irradiance.is_some() && jobs.len() > 1 {
-        return bad(Usage::IrradianceOfBatch);
+        return bad(Usage::OneFileOfBatch(Setting::Irradiance));
+    }
+    if e.brdf_lut.is_some() && jobs.len() > 1 {
+        return bad(Usage::OneFileOfBatch(Setting::BrdfLut));
+    }
+    if e.brdf_lut.is_some() && !matches!(e.prefilter, Some((Lobe::Ggx, _))) {
+        return bad(Usage::BrdfLutNeedsGgx);
     }
     if let Some(target) = e.target {
         let kind = match target {
@@ -544,7 +559,9 @@ mod tests {
             },
             Usage::PrefilterNeedsCube,
             Usage::IrradianceNeedsEnvironment,
-            Usage::IrradianceOfBatch,
+            Usage::OneFileOfBatch(Setting::Irradiance),
+            Usage::OneFileOfBatch(Setting::BrdfLut),
+            Usage::BrdfLutNeedsGgx,
         ];
         // A long option's prefix, spelt so that a search of the library
         // for flag names in string literals finds none here.

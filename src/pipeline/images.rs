@@ -107,6 +107,7 @@ pub(super) fn process(
         block_format: s.compress.map(|(bf, _)| block_label(bf, out_format)),
         image_kind: target,
         plan: plan.clone(),
+        lighting: super::lighting(s, &plan),
     };
     if s.dry_run {
         return Ok(out);
@@ -117,6 +118,10 @@ pub(super) fn process(
     if s.update
         && stored(&job.output, job.kind)
         && s.env.irradiance.as_ref().is_none_or(|(p, k)| stored(p, *k))
+        && s.env
+            .brdf_lut
+            .as_ref()
+            .is_none_or(|(p, k, _)| stored(p, *k))
     {
         out.status = Status::UpToDate;
         return Ok(out);
@@ -133,6 +138,9 @@ pub(super) fn process(
         &mut out.notes,
         progress,
     )?;
+    if let Some(l) = &mut out.lighting {
+        l.sh9 = Some(prefilter::sh9(&environment_faces(&images, target)?)?);
+    }
     out.build_s = t_build.elapsed().as_secs_f64();
     let blocks = match s.compress {
         Some((bf, quality)) => {
@@ -213,6 +221,9 @@ fn write(
     }
     if let Some((path, kind)) = &s.env.irradiance {
         write_irradiance(images, target, s, path, *kind, &save)?;
+    }
+    if let Some((path, kind, size)) = &s.env.brdf_lut {
+        write_brdf_lut(*size, s, path, *kind, &save)?;
     }
     Ok(())
 }
@@ -492,7 +503,9 @@ fn build(
         _ => environment(bases, source, target, plan, src, s)?,
     };
     let mut images = images;
-    if target.is_cube() && s.env.edge_fixup {
+    // Prefiltered levels are the integral at each texel's own direction:
+    // joining their edges would move them off it.
+    if target.is_cube() && s.env.edge_fixup && plan.path != BuildPath::Prefiltered {
         images = join_edges(images, &plan.options)?;
     }
     if let Some(c) = clipped {
@@ -588,8 +601,8 @@ fn environment(
         }
         _ => cube::build_faces(lin, &plan.options)?,
     };
-    if let Some((lobe, samples)) = s.env.prefilter {
-        chains = prefilter::specular(&chains, lobe, samples)?;
+    if let Some((lobe, how)) = s.env.prefilter {
+        chains = prefilter::specular(&chains, lobe, how)?;
     }
     let count_clipped = src.channel_type.is_float() && !plan.out_format.channel_type.is_float();
     let mut images = Vec::with_capacity(chains.len());
@@ -657,6 +670,64 @@ fn merge_reports(mut a: BlockReport, b: BlockReport) -> BlockReport {
     a
 }
 
+/// The save options of a file written beside the job's output: its
+/// attributes without the specular levels' own, and `what` it holds.
+fn beside(save: &SaveOptions, what: (&str, &str)) -> SaveOptions {
+    let mut save = save.clone();
+    save.attributes
+        .retain(|(k, _)| k != "parvo:prefilter" && k != "parvo:roughness");
+    save.attributes.push((what.0.into(), what.1.into()));
+    save
+}
+
+/// GGX's split-sum BRDF table ([`prefilter::dfg::table`]), `size²`,
+/// written to `path`: as `--type` says where the container stores it,
+/// else f16 (16-bit for PNG).
+fn write_brdf_lut(
+    size: u32,
+    s: &Settings,
+    path: &std::path::Path,
+    kind: OutputKind,
+    save: &SaveOptions,
+) -> Result<()> {
+    let table = prefilter::dfg::table(size)?;
+    let ty = s
+        .out_type
+        .filter(|t| kind.supports(*t))
+        .or([ChannelType::F16, ChannelType::U16]
+            .into_iter()
+            .find(|t| kind.supports(*t)))
+        .unwrap_or(kind.default_type(ChannelType::F16));
+    let out = kind.storable(Format {
+        channel_type: ty,
+        ..table.format()
+    });
+    let level = mip::band::convert_level(table, out)?;
+    let save = beside(
+        save,
+        (
+            "parvo:brdf-lut",
+            "GGX split sum: R scale, G bias of F0; n.v across, roughness down",
+        ),
+    );
+    let images = [std::slice::from_ref(&level)];
+    io::save_images(&images, ImageKind::Plain, Rounding::Down, path, kind, &save)
+}
+
+/// The first cube map of the built `images` (a cube map's faces, or a
+/// lat-long map made one, faces a quarter of its width) as six face
+/// chains, for the lighting computed from it.
+fn environment_faces(images: &[Vec<Texture>], target: ImageKind) -> Result<Vec<MipChain>> {
+    let chain = |l: &Vec<Texture>| MipChain::from_levels(l.clone(), MipOptions::default());
+    if target == ImageKind::LatLong {
+        let ll = chain(&images[0])?;
+        let n = (ll.levels()[0].width() / 4).max(1);
+        cube::build_faces(convert::latlong_to_cube(&ll, n)?, &MipOptions::default())
+    } else {
+        images[..6].iter().map(chain).collect()
+    }
+}
+
 /// The diffuse irradiance of the environment `images` (a cube map's
 /// faces, or a lat-long map made a cube map first), written as a cube
 /// map of 32×32 faces to `path`.
@@ -668,15 +739,7 @@ fn write_irradiance(
     kind: OutputKind,
     save: &SaveOptions,
 ) -> Result<()> {
-    let chain = |l: &Vec<Texture>| MipChain::from_levels(l.clone(), MipOptions::default());
-    let faces: Vec<MipChain> = if target == ImageKind::LatLong {
-        let ll = chain(&images[0])?;
-        let n = (ll.levels()[0].width() / 4).max(1);
-        cube::build_faces(convert::latlong_to_cube(&ll, n)?, &MipOptions::default())?
-    } else {
-        images[..6].iter().map(chain).collect::<Result<_>>()?
-    };
-    let irr = prefilter::irradiance(&faces, 32)?;
+    let irr = prefilter::irradiance(&environment_faces(images, target)?, 32)?;
     let ty = s
         .out_type
         .filter(|t| kind.supports(*t))
@@ -699,5 +762,6 @@ fn write_irradiance(
     if !kind.holds(ImageKind::Cube) {
         return Err(kind_not_stored(ImageKind::Cube, kind));
     }
-    io::save_images(&refs, ImageKind::Cube, Rounding::Down, path, kind, save)
+    let save = beside(save, ("parvo:irradiance", "cosine lobe / pi, quadrature"));
+    io::save_images(&refs, ImageKind::Cube, Rounding::Down, path, kind, &save)
 }

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use crate::compress::{BlockFormat, Quality};
-use crate::env::prefilter::Lobe;
+use crate::env::prefilter::{Integration, Lobe};
 use crate::io::exr::ExrOptions;
 use crate::io::ktx2::Ktx2Options;
 use crate::io::{Environment, Limits, LoadOptions, OutputKind};
@@ -104,11 +104,14 @@ pub struct EnvSettings {
     /// a quarter of its width).
     pub face_size: Option<u32>,
     /// Prefiltered specular levels instead of a plain chain (cube maps):
-    /// the lobe and the lobe directions per texel
+    /// the lobe and how it is integrated
     /// ([`crate::env::prefilter::specular`]).
-    pub prefilter: Option<(Lobe, u32)>,
+    pub prefilter: Option<(Lobe, Integration)>,
     /// Also write the diffuse irradiance (a cube map of 32×32 faces) here.
     pub irradiance: Option<(PathBuf, OutputKind)>,
+    /// Also write GGX's split-sum BRDF table, `size × size`, here
+    /// ([`crate::env::prefilter::dfg::table`]).
+    pub brdf_lut: Option<(PathBuf, OutputKind, u32)>,
     /// Average the texels along cube faces' edges from level 1 on
     /// ([`crate::env::cube::fix_edges`]).
     pub edge_fixup: bool,
@@ -121,6 +124,7 @@ impl EnvSettings {
             || self.face_size.is_some()
             || self.prefilter.is_some()
             || self.irradiance.is_some()
+            || self.brdf_lut.is_some()
             || !self.edge_fixup
     }
 }
@@ -132,6 +136,7 @@ impl Default for EnvSettings {
             face_size: None,
             prefilter: None,
             irradiance: None,
+            brdf_lut: None,
             edge_fixup: true,
         }
     }

@@ -151,6 +151,23 @@ fn json_reports_every_level() {
         c["bytes"].as_u64().unwrap() + 148,
         std::fs::metadata(&out).unwrap().len()
     );
+    // A cube map's bytes are its six faces', per texel of the six.
+    let cube = dir.path().join("c.ktx2");
+    let o = ok(&parvo(&[
+        "mip",
+        "tests/data/peer/openexr-images/WavyLinesCube.exr",
+        "-o",
+        p(&cube),
+        "--levels",
+        "2",
+        "--compress",
+        "bc6h",
+        "--json",
+    ]));
+    let v: serde_json::Value = serde_json::from_str(o.trim()).unwrap();
+    let l0 = &v["compression"]["levels"][0];
+    assert_eq!(l0["bytes"].as_u64().unwrap(), 6 * 256 * 256);
+    assert_eq!(l0["bytes_per_texel"].as_f64().unwrap(), 1.0);
     // WebGL takes this chain (level 0 a multiple of 4; WEBGL_compressed_
     // texture_s3tc revision 6): nothing said. A 42² level 0 is not whole
     // blocks: said on stderr.

@@ -758,26 +758,91 @@ fn mip_builds_environment_maps_from_every_input() {
     ]));
     assert_eq!(info_json(&p("f.ktx2"))["kind"], "array");
 
-    // Prefiltered: float levels, the first equal to the plain level 0.
-    run(v(&[
+    // Prefiltered: float levels, each level's roughness recorded in the
+    // file and printed with the SH9 coefficients.
+    let o = parvo(&[
         "mip",
         &s(&p("strip.exr")),
         "--env",
         "cube",
         "--prefilter",
         "ggx",
-        "--prefilter-samples",
-        "16",
         "--irradiance",
         &s(&p("irr.ktx2")),
+        "--brdf-lut",
+        &s(&p("lut.exr")),
+        "--brdf-lut-size",
+        "24",
+        "--json",
         "-o",
         &s(&p("g.ktx2")),
-    ]));
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let j = info_json(&p("g.ktx2"));
     assert_eq!(
         (j["kind"].as_str(), j["type"].as_str()),
         (Some("cube"), Some("f16"))
     );
+    let levels = j["levels"].as_array().unwrap().len();
+    let want: Vec<f64> = (0..levels)
+        .map(|k| (k as f64 / (levels - 1) as f64).powi(2))
+        .collect();
+    let stored: Vec<f64> = j["attributes"]["parvo:roughness"]
+        .as_str()
+        .unwrap()
+        .split(' ')
+        .map(|a| a.parse().unwrap())
+        .collect();
+    let printed: Vec<f64> = out["lighting"]["roughness"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_f64().unwrap())
+        .collect();
+    for (got, want) in stored.iter().zip(&want).chain(printed.iter().zip(&want)) {
+        assert!((got - want).abs() < 1e-6, "{stored:?} {printed:?}");
+    }
+    assert_eq!((stored.len(), printed.len()), (levels, levels));
+    assert_eq!(out["lighting"]["prefilter"], "ggx");
+    let sh9 = out["lighting"]["sh9"].as_array().unwrap();
+    assert_eq!(sh9.len(), 9);
+    // The DC term of a positive environment: positive in every channel.
+    assert!(
+        sh9[0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|c| c.as_f64().unwrap() > 0.0)
+    );
+    // The BRDF table: the library's, stored as f16.
+    let lut = parvo::io::load(&s(&p("lut.exr")), &parvo::io::Limits::default()).unwrap();
+    let want = parvo::env::prefilter::dfg::table(24).unwrap();
+    let got = lut.base();
+    assert_eq!((got.width(), got.height()), (24, 24));
+    for (i, j) in [(0, 0), (23, 0), (5, 17), (23, 23)] {
+        let (g, w) = (got.texel_linear(i, j), want.texel_linear(i, j));
+        for c in 0..3 {
+            // f16: 11 significant bits, and nothing below 6e-8.
+            assert!(
+                (g[c] - w[c]).abs() <= w[c].abs() / 1024.0 + 6e-8,
+                "{g:?} {w:?}"
+            );
+        }
+    }
+    let o = parvo(&[
+        "mip",
+        &s(&p("strip.exr")),
+        "--env",
+        "cube",
+        "--brdf-lut",
+        &s(&p("lut2.png")),
+        "-o",
+        &s(&p("g2.ktx2")),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--prefilter"));
+    assert!(!p("g2.ktx2").exists() && !p("lut2.png").exists());
     let j = info_json(&p("irr.ktx2"));
     assert_eq!(
         (j["kind"].as_str(), j["width"].as_u64()),
