@@ -846,7 +846,8 @@ fn stats_line(o: &Outcome) -> String {
             b.stored
         ));
         for (k, l) in b.levels.iter().enumerate() {
-            let texels = l.width as f64 * l.height as f64;
+            // Bytes are summed over every face and layer.
+            let texels = l.width as f64 * l.height as f64 * o.image_kind.images() as f64;
             text.push_str(&format!(
                 "\n  {k:>5} {:>11} {:>11} {:>12.3} {:>9} {:>9.3}",
                 format!("{}x{}", l.width, l.height),
@@ -895,7 +896,8 @@ fn json_line(job: &Job, o: &Outcome, secs: f64) -> String {
                 "width": l.width,
                 "height": l.height,
                 "bytes": l.bytes,
-                "bytes_per_texel": l.bytes as f64 / (l.width as f64 * l.height as f64),
+                "bytes_per_texel": l.bytes as f64
+                    / (l.width as f64 * l.height as f64 * o.image_kind.images() as f64),
                 // JSON has no infinity: identical levels report null.
                 "psnr_db": l.psnr_db.filter(|p| p.is_finite()),
                 "encode_seconds": l.encode_s,
