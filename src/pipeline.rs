@@ -838,6 +838,23 @@ fn write_fused(
     Ok(Ok(source.build.as_secs_f64()))
 }
 
+/// What is said when an sRGB-encoded cube map, array or lat-long map is
+/// stored as float levels: they hold its values decoded to linear light
+/// (OpenEXR has no sRGB; a float `--type` elsewhere). A 2-D job's summary
+/// line says `linear` and a batch of them says nothing more.
+fn decoded_note(src: Format, out: Format) -> Option<Note> {
+    (src.color_space == ColorSpace::Srgb
+        && out.color_space == ColorSpace::Linear
+        && out.channel_type.is_float())
+    .then(|| {
+        Note::Text(format!(
+            "the sRGB-encoded input is stored decoded to linear light ({} levels hold linear \
+             values)",
+            out.channel_type.name()
+        ))
+    })
+}
+
 /// Level files an earlier, longer chain left behind under `template`
 /// (the chain now has `levels`), removed, and what was said of them.
 fn stale_level_notes(template: &Path, levels: usize) -> Result<Vec<Note>> {

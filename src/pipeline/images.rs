@@ -102,7 +102,10 @@ pub(super) fn process(
         read_s: input.read_s,
         build_s: 0.0,
         write_s: 0.0,
-        notes: std::mem::take(&mut input.notes),
+        notes: std::mem::take(&mut input.notes)
+            .into_iter()
+            .chain(super::decoded_note(src, out_format))
+            .collect(),
         blocks: None,
         block_format: s.compress.map(|(bf, _)| block_label(bf, out_format)),
         image_kind: target,

@@ -750,6 +750,29 @@ fn mip_builds_environment_maps_from_every_input() {
         &s(&p("e.ktx2")),
     ]));
     assert_eq!(info_json(&p("e.ktx2"))["kind"], "cube");
+    // The same sRGB cube map to OpenEXR: linear floats, said on stderr;
+    // to KTX2 (above) it stays sRGB and nothing is said.
+    let o = parvo(&[
+        "mip",
+        cts("valid_R8G8B8A8_SRGB_CUBE.ktx2").to_str().unwrap(),
+        "-o",
+        &s(&p("e.exr")),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("decoded to linear light"), "{err}");
+    let j = info_json(&p("e.exr"));
+    assert_eq!(
+        (j["kind"].as_str(), j["color"].as_str()),
+        (Some("cube"), Some("linear"))
+    );
+    let o = parvo(&[
+        "mip",
+        cts("valid_R8G8B8A8_SRGB_CUBE.ktx2").to_str().unwrap(),
+        "-o",
+        &s(&p("e2.ktx2")),
+    ]);
+    assert!(String::from_utf8_lossy(&o.stderr).is_empty());
     run(v(&[
         "mip",
         cts("valid_R8G8B8A8_SRGB_2D_ARRAY.ktx2").to_str().unwrap(),
