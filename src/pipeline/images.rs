@@ -62,18 +62,7 @@ pub(super) fn process(
     check_kind(job, s, source, target, path)?;
     let bases = std::mem::take(&mut input.images);
     let src = input.src;
-    let out_format = match path {
-        // Prefiltered levels are linear RGBA floats (f32 for f32 sources).
-        BuildPath::Prefiltered => {
-            let ty = if src.channel_type == ChannelType::F32 {
-                ChannelType::F32
-            } else {
-                ChannelType::F16
-            };
-            output_format_of(job, s, Format::new(4, ty, ColorSpace::Linear))?
-        }
-        _ => output_format_of(job, s, src)?,
-    };
+    let out_format = output_format_for(job, s, src, path)?;
     let plan = images_plan(
         job,
         s,
@@ -715,6 +704,20 @@ fn write_brdf_lut(
     );
     let images = [std::slice::from_ref(&level)];
     io::save_images(&images, ImageKind::Plain, Rounding::Down, path, kind, &save)
+}
+
+/// The output format of a job of `path` over a source of format `src`:
+/// prefiltered levels are linear RGBA floats (f32 for f32 sources).
+fn output_format_for(job: &Job, s: &Settings, src: Format, path: BuildPath) -> Result<Format> {
+    if path != BuildPath::Prefiltered {
+        return output_format_of(job, s, src);
+    }
+    let ty = if src.channel_type == ChannelType::F32 {
+        ChannelType::F32
+    } else {
+        ChannelType::F16
+    };
+    output_format_of(job, s, Format::new(4, ty, ColorSpace::Linear))
 }
 
 /// The first cube map of the built `images` (a cube map's faces, or a
