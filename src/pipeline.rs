@@ -540,6 +540,7 @@ fn save_options(
         fingerprint: Some(fingerprint),
         ktx2: s.ktx2,
         attributes,
+        placement: crate::env::Placement::Centred,
     }
 }
 

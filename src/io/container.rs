@@ -209,6 +209,12 @@ pub trait Container: Send + Sync {
     fn holds(&self, kind: ImageKind) -> bool {
         kind == ImageKind::Plain
     }
+    /// Where the texels of the environment maps this container writes
+    /// sit ([`SaveOptions::placement`] says where those given to `save`
+    /// do): centred for every container but OpenEXR.
+    fn placement(&self) -> crate::env::Placement {
+        crate::env::Placement::Centred
+    }
 }
 
 fn cannot_hold(name: &str, kind: ImageKind, path: &Path) -> Error {
@@ -397,6 +403,12 @@ impl OutputKind {
         // Every OutputKind is made from an entry that stores (`outputs`,
         // the constants below): `NOTHING` is never seen.
         self.0.stores().unwrap_or(Stores::NOTHING)
+    }
+
+    /// Where the texels of the environment maps this container writes
+    /// sit.
+    pub fn placement(self) -> crate::env::Placement {
+        self.0.placement()
     }
 
     /// Display name of the container ("OpenEXR", "PNG", ...).

@@ -800,6 +800,12 @@ pub struct SaveOptions {
     pub channel_names: Option<Vec<String>>,
     /// KTX2's options (supercompression).
     pub ktx2: ktx2::Ktx2Options,
+    /// Where the texels of the environment maps given to `save` sit:
+    /// centred (the default, what parvo builds) is resampled to the
+    /// container's own placement where it defines another (OpenEXR's
+    /// lat-long and cube maps, [`exr::edges_from_centred`]); `Edges` says
+    /// they are placed as OpenEXR places them already.
+    pub placement: crate::env::Placement,
 }
 
 /// The fingerprint stored in an existing output (EXR attribute or KTX2

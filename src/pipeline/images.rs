@@ -16,7 +16,7 @@ use super::{
     output_format_of, read_as, resize, save_options,
 };
 use crate::compress::BlockChain;
-use crate::env::{convert, cube, latlong, prefilter};
+use crate::env::{Placement, convert, cube, latlong, prefilter};
 use crate::error::{Error, Result};
 use crate::io::source::{self, Source};
 use crate::io::{self, Environment, EnvironmentMaps, LoadOptions, Loaded, OutputKind, SaveOptions};
@@ -143,14 +143,16 @@ pub(super) fn process(
     };
     progress(Stage::Writing);
     let t_write = Instant::now();
+    let save = save_options(s, &plan, src, fingerprint, None);
+    let kept = kept_level0(job, source, target, input.placed, &images)?;
     write(
         job,
         s,
         &plan,
-        src,
-        fingerprint,
+        &save,
         &images,
         blocks.as_ref().map(|b| &b.0),
+        kept,
     )?;
     out.write_s = t_write.elapsed().as_secs_f64();
     out.blocks = blocks.and_then(|(_, r)| r);
@@ -191,31 +193,68 @@ fn fingerprint(s: &Settings, plan: &Plan, bases: &[Texture]) -> String {
     io::fingerprint(&bases[0], &text)
 }
 
+/// The input's level 0 of each image, as the file placed its texels and
+/// in the built levels' formats, where the output container places them
+/// the same way (an OpenEXR environment written to OpenEXR) and the
+/// image stays of its kind: written as it was read rather than resampled
+/// to centred texels and back.
+fn kept_level0(
+    job: &Job,
+    source: ImageKind,
+    target: ImageKind,
+    placed: Option<(Placement, Vec<Texture>)>,
+    images: &[Vec<Texture>],
+) -> Result<Option<(Placement, Vec<Texture>)>> {
+    let Some((placement, levels)) = placed else {
+        return Ok(None);
+    };
+    if placement != job.kind.placement() || source != target || levels.len() != images.len() {
+        return Ok(None);
+    }
+    let kept = levels
+        .into_iter()
+        .zip(images)
+        .map(|(t, built)| mip::band::convert_level(t, built[0].format()))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Some((placement, kept)))
+}
+
 /// Write the built `images` (or their `blocks`) and the irradiance beside
-/// them, through the containers' `save`.
+/// them, through the containers' `save`; `kept` replaces level 0 of each
+/// image (already placed as the container places texels,
+/// [`kept_level0`]).
 fn write(
     job: &Job,
     s: &Settings,
     plan: &Plan,
-    src: Format,
-    fingerprint: String,
+    save: &SaveOptions,
     images: &[Vec<Texture>],
     blocks: Option<&Vec<BlockChain>>,
+    kept: Option<(Placement, Vec<Texture>)>,
 ) -> Result<()> {
     let target = plan.image_kind;
-    let save = save_options(s, plan, src, fingerprint, None);
-    match blocks {
-        Some(chains) => io::save_blocks(chains, target, &job.output, job.kind, &save)?,
-        None => {
-            let refs: Vec<&[Texture]> = images.iter().map(Vec::as_slice).collect();
+    let refs: Vec<&[Texture]> = images.iter().map(Vec::as_slice).collect();
+    match (blocks, kept) {
+        (Some(chains), _) => io::save_blocks(chains, target, &job.output, job.kind, save)?,
+        (None, Some((placement, level0))) => {
+            let mut placed = io::exr::edges_from_centred(&refs, target, 1)?;
+            for (levels, t) in placed.iter_mut().zip(level0) {
+                levels[0] = t;
+            }
+            let refs: Vec<&[Texture]> = placed.iter().map(Vec::as_slice).collect();
+            let save = SaveOptions {
+                placement,
+                ..save.clone()
+            };
             io::save_images(&refs, target, s.rounding, &job.output, job.kind, &save)?
         }
+        (None, None) => io::save_images(&refs, target, s.rounding, &job.output, job.kind, save)?,
     }
     if let Some((path, kind)) = &s.env.irradiance {
-        write_irradiance(images, target, s, path, *kind, &save)?;
+        write_irradiance(images, target, s, path, *kind, save)?;
     }
     if let Some((path, kind, size)) = &s.env.brdf_lut {
-        write_brdf_lut(*size, s, path, *kind, &save)?;
+        write_brdf_lut(*size, s, path, *kind, save)?;
     }
     Ok(())
 }
@@ -224,6 +263,11 @@ fn write(
 /// 2-D image: interpreted under the settings, NaN policy applied, resized.
 struct Images {
     images: Vec<Texture>,
+    /// Level 0 of each image as the file places its texels, where that
+    /// is not centred (an OpenEXR environment; `images` holds them
+    /// resampled to centred) and no resize changed them: written back
+    /// as they are to a container of the same placement.
+    placed: Option<(crate::env::Placement, Vec<Texture>)>,
     src: Format,
     file_wrap: Option<Wrap>,
     notes: Vec<Note>,
@@ -255,7 +299,12 @@ fn read(
             (source::from_faces(faces, &job.faces)?, notes, None)
         }
     };
-    let Source { kind, images, .. } = source;
+    let Source {
+        kind,
+        images,
+        placement,
+    } = source;
+    let mut placed = (placement != Placement::Centred).then(Vec::new);
     let mut bases = Vec::with_capacity(images.len());
     let mut src = None;
     let read_s = t_read.elapsed().as_secs_f64();
@@ -267,7 +316,14 @@ fn read(
         if base.channel_type().is_float() {
             mip::nan::apply(&mut base, s.nan_policy)?;
         }
+        if let Some(p) = &mut placed {
+            let centred = io::exr::centred_from_edges(&base)?;
+            p.push(std::mem::replace(&mut base, centred));
+        }
         let (base, resized) = resize(base, s, wrap)?;
+        if resized.is_some() {
+            placed = None;
+        }
         if bases.is_empty() {
             notes.extend(resized);
         }
@@ -279,6 +335,7 @@ fn read(
         kind,
         Images {
             images: bases,
+            placed: placed.map(|p| (placement, p)),
             src,
             file_wrap,
             notes,

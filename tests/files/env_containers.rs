@@ -334,13 +334,36 @@ fn openexr_environments_are_strips_and_lat_long_maps_with_envmap() {
         .map(|t| (t.width(), t.height()))
         .collect();
     assert_eq!(sizes, [(8, 48), (4, 24), (2, 12), (1, 6), (1, 3), (1, 1)]);
+    // The strip holds OpenEXR's faces (mirrored against GL's) with
+    // OpenEXR's texel placement: the centred texels given, resampled.
+    let placed = io::exr::edges_from_centred(&refs, ImageKind::Cube, 0).unwrap();
     for (k, level) in back.levels.iter().enumerate().take(4) {
-        // The strip holds OpenEXR's faces: mirrored against GL's.
         let stacked = io::exr::mirror_cube_faces(&faces_from_strip(level).unwrap()).unwrap();
         for f in 0..6 {
-            assert_eq!(stacked[f], levels[f][k], "level {k} face {f}");
+            assert_eq!(stacked[f], placed[f][k], "level {k} face {f}");
         }
     }
+    // Texels said to be placed as OpenEXR places them are written as
+    // they are.
+    let as_given = dir.path().join("as_given.exr");
+    let placed_refs: Vec<&[Texture]> = placed.iter().map(Vec::as_slice).collect();
+    let edges = SaveOptions {
+        placement: parvo::env::Placement::Edges,
+        ..SaveOptions::default()
+    };
+    io::save_images(
+        &placed_refs,
+        ImageKind::Cube,
+        Rounding::Down,
+        &as_given,
+        OutputKind::EXR,
+        &edges,
+    )
+    .unwrap();
+    assert_eq!(
+        std::fs::read(&as_given).unwrap(),
+        std::fs::read(&out).unwrap()
+    );
     // Refused where one image is read: it is not a plain texture.
     assert!(io::load(out.to_str().unwrap(), &io::Limits::default()).is_err());
 
@@ -710,9 +733,13 @@ fn mip_builds_environment_maps_from_every_input() {
     // The six files and the strip give the same cube map.
     let a = load(&p("a.ktx2"));
     let b = io::load_with(&s(&p("b.exr")), &io::Limits::default(), &accept()).unwrap();
-    // The strip holds OpenEXR's faces (mirrored against GL's).
+    // The strip holds OpenEXR's faces (mirrored against GL's), its texels
+    // placed as OpenEXR places them.
     let b_faces = io::exr::mirror_cube_faces(&faces_from_strip(&b.levels[1]).unwrap()).unwrap();
-    for (f, t) in a.into_images().iter().enumerate() {
+    let a_images = a.into_images();
+    let a_refs: Vec<&[Texture]> = a_images.iter().map(Vec::as_slice).collect();
+    let a_placed = io::exr::edges_from_centred(&a_refs, ImageKind::Cube, 0).unwrap();
+    for (f, t) in a_placed.iter().enumerate() {
         let want = t[1].convert(f16).unwrap();
         assert_eq!(b_faces[f], want, "face {f} level 1");
     }
@@ -995,7 +1022,8 @@ fn dds_cube_maps_and_arrays_round_trip_image_by_image() {
 /// openexr-images' environments (`MultiResolution/WavyLinesCube.exr`,
 /// `WavyLinesLatLong.exr`, maketx-style files with their own levels)
 /// keep their kind through `parvo mip` (no `--env`: the files say what
-/// they are), and level 0 comes back texel for texel.
+/// they are), and level 0 comes back texel for texel to OpenEXR, and as
+/// OpenEXR's texels resampled to centred ones in KTX2.
 #[test]
 fn openexr_images_environments_round_trip() {
     let dir = tempfile::tempdir().unwrap();
@@ -1021,9 +1049,14 @@ fn openexr_images_environments_round_trip() {
             let a = load(&src);
             let b = load(&out);
             let (a0, b0) = if kind == "cube" && ext == "ktx2" {
-                // OpenEXR's faces; the KTX2 holds GL's.
-                let faces =
-                    io::exr::mirror_cube_faces(&faces_from_strip(a.base()).unwrap()).unwrap();
+                // OpenEXR's faces and texel placement; the KTX2 holds GL's
+                // faces with centred texels, resampled from OpenEXR's.
+                let faces: Vec<Texture> =
+                    io::exr::mirror_cube_faces(&faces_from_strip(a.base()).unwrap())
+                        .unwrap()
+                        .iter()
+                        .map(|f| io::exr::centred_from_edges(f).unwrap())
+                        .collect();
                 let strip = parvo::env::cube::strip_from_faces(
                     &b.into_images().iter().map(|l| &l[0]).collect::<Vec<_>>(),
                 )

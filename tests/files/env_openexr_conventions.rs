@@ -351,3 +351,370 @@ fn openexr_cube_and_lat_long_of_one_environment_agree() {
         "p90 {p90} against GL's reading's {old_p90}"
     );
 }
+
+// --- Placement through the pipeline, against the definitions ---
+//
+// Files whose texels hold a smooth environment `smooth_env` exactly where
+// each convention places them (OpenEXR's `CubeMap`/`LatLongMap` texel
+// directions, GL's face centres, maketx's lat-long centres), run through
+// `parvo mip`; every texel of the output must hold the environment at
+// the direction its own convention gives it. Reading one convention as
+// the other is off by half a texel: ~0.4 × half a texel's angle.
+
+fn smooth_env(d: [f64; 3]) -> [f64; 3] {
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    [
+        0.5 + 0.4 * d[0] / n,
+        0.5 + 0.3 * d[1] / n + 0.1 * (d[0] * d[2]) / (n * n),
+        0.5 + 0.4 * d[2] / n,
+    ]
+}
+
+/// The direction of texel `(x, y)` (integer position within face `face`)
+/// of an OpenEXR cube strip of `sof`-texel faces: `CubeMap::direction` of
+/// `pixelPosition`'s inverse, checked against [`imf_cube_pixel`].
+fn imf_cube_direction(face: usize, x: u32, y: u32, sof: u32) -> [f64; 3] {
+    let s = (sof - 1) as f64;
+    let (x, y) = (x as f64, y as f64);
+    let (p0, p1) = match face {
+        0 => (s - y, x),
+        1 => (s - y, s - x),
+        2 => (x, s - y),
+        3 => (x, y),
+        4 => (s - x, s - y),
+        _ => (x, s - y),
+    };
+    let (u, v) = (2.0 * p0 / s - 1.0, 2.0 * p1 / s - 1.0);
+    let sign = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+    let d = match face / 2 {
+        0 => [sign, u, v],
+        1 => [u, sign, v],
+        _ => [u, v, sign],
+    };
+    // Off the cube's edges (where a direction has one face), the forward
+    // mapping gives the texel back.
+    if u.abs() < 1.0 && v.abs() < 1.0 {
+        let (f, (px, py)) = imf_cube_pixel(d, sof);
+        assert_eq!(f, face);
+        assert!((px - x).abs() < 1e-9 && (py - (face as u32 * sof) as f64 - y).abs() < 1e-9);
+    }
+    d
+}
+
+/// The direction of the centre of texel `(i, j)` of GL's face `f`
+/// (`n`×`n`): the inverse of the cube-map face selection table of the GL
+/// specification (8.13), s = (sc/|ma| + 1)/2, t = (tc/|ma| + 1)/2.
+fn gl_face_direction(f: usize, i: u32, j: u32, n: u32) -> [f64; 3] {
+    let a = 2.0 * (i as f64 + 0.5) / n as f64 - 1.0;
+    let b = 2.0 * (j as f64 + 0.5) / n as f64 - 1.0;
+    match f {
+        0 => [1.0, -b, -a],
+        1 => [-1.0, -b, a],
+        2 => [a, 1.0, b],
+        3 => [a, -1.0, -b],
+        4 => [a, -b, 1.0],
+        _ => [-a, -b, -1.0],
+    }
+}
+
+/// The direction of a lat-long map's position `(s, t)` (fractions of the
+/// map; longitude +π at s = 0, the +y pole at t = 0):
+/// `LatLongMap::direction`.
+fn lat_long_direction(s: f64, t: f64) -> [f64; 3] {
+    let lon = -2.0 * PI * (s - 0.5);
+    let lat = -PI * (t - 0.5);
+    [lon.sin() * lat.cos(), lat.sin(), lon.cos() * lat.cos()]
+}
+
+fn rgb_f32() -> parvo::Format {
+    parvo::Format::new(3, parvo::ChannelType::F32, parvo::ColorSpace::Linear)
+}
+
+/// A `w`×`h` RGB f32 image holding `smooth_env` at `dir(x, y)`.
+fn image_of(w: u32, h: u32, dir: impl Fn(u32, u32) -> [f64; 3]) -> Texture {
+    let mut v = Vec::with_capacity((w * h * 3) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            v.extend(smooth_env(dir(x, y)).map(|c| c as f32));
+        }
+    }
+    Texture::from_linear(w, h, rgb_f32(), &v).unwrap()
+}
+
+/// The largest difference between `t`'s texels and `smooth_env` at
+/// `dir(x, y)`, over the rows `rows`.
+fn worst_against(
+    t: &Texture,
+    rows: std::ops::Range<u32>,
+    dir: impl Fn(u32, u32) -> [f64; 3],
+) -> f64 {
+    let lin = t.to_linear();
+    let mut worst = 0.0f64;
+    for y in rows {
+        for x in 0..t.width() {
+            let want = smooth_env(dir(x, y));
+            let i = ((y * t.width() + x) * 3) as usize;
+            for c in 0..3 {
+                worst = worst.max((lin[i + c] as f64 - want[c]).abs());
+            }
+        }
+    }
+    worst
+}
+
+fn mip(args: &[&str]) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_parvo"))
+        .arg("mip")
+        .args(args)
+        .args(["--type", "f32"])
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// OpenEXR's cube strip to a KTX2 cube (GL's faces, centred texels) and
+/// a KTX2 cube to OpenEXR's strip: every output texel holds the
+/// environment where its container places it.
+#[test]
+fn cube_texels_are_placed_as_each_container_defines_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 32;
+    // An OpenEXR strip, texels at ImfEnvmap's directions.
+    let strip = image_of(n, 6 * n, |x, y| {
+        imf_cube_direction((y / n) as usize, x, y % n, n)
+    });
+    let exr = dir.path().join("imf.exr");
+    io::exr::save_environment(
+        std::slice::from_ref(&strip),
+        parvo::mip::Rounding::Down,
+        &exr,
+        &io::SaveOptions::default(),
+        io::Environment::Cube,
+    )
+    .unwrap();
+    let ktx2 = dir.path().join("gl.ktx2");
+    mip(&[s(&exr), "-o", s(&ktx2)]);
+    let faces = load(&ktx2).into_images();
+    let got = (0..6)
+        .map(|f| worst_against(&faces[f][0], 0..n, |i, j| gl_face_direction(f, i, j, n)))
+        .fold(0.0, f64::max);
+    // The strip's faces (mirrored to GL's) read as centred, unresampled:
+    // what parvo wrote before.
+    let as_is =
+        io::exr::mirror_cube_faces(&parvo::env::cube::faces_from_strip(&strip).unwrap()).unwrap();
+    let before = (0..6)
+        .map(|f| worst_against(&as_is[f], 0..n, |i, j| gl_face_direction(f, i, j, n)))
+        .fold(0.0, f64::max);
+    eprintln!("OpenEXR strip -> KTX2: worst {got:.2e}; unresampled {before:.2e}");
+    assert!(got < 5e-4 && got * 10.0 < before, "{got} against {before}");
+
+    // Back: a KTX2 cube of GL's centres to an OpenEXR strip.
+    let gl: Vec<Vec<Texture>> = (0..6)
+        .map(|f| vec![image_of(n, n, |i, j| gl_face_direction(f, i, j, n))])
+        .collect();
+    let refs: Vec<&[Texture]> = gl.iter().map(Vec::as_slice).collect();
+    let src = dir.path().join("src.ktx2");
+    io::save_images(
+        &refs,
+        ImageKind::Cube,
+        parvo::mip::Rounding::Down,
+        &src,
+        io::OutputKind::KTX2,
+        &io::SaveOptions::default(),
+    )
+    .unwrap();
+    let out = dir.path().join("out.exr");
+    mip(&[s(&src), "-o", s(&out)]);
+    let back = load(&out).base().clone();
+    let got = worst_against(&back, 0..6 * n, |x, y| {
+        imf_cube_direction((y / n) as usize, x, y % n, n)
+    });
+    eprintln!("KTX2 -> OpenEXR strip: worst {got:.2e} (edges and corners included)");
+    assert!(got < 5e-4 && got * 10.0 < before, "{got} against {before}");
+}
+
+/// A lat-long map both ways: OpenEXR's (`envmap`) through `parvo mip` to
+/// OpenEXR, whose level 0 comes back as it was and whose level 1 holds
+/// the environment at OpenEXR's texel directions; and maketx's centred
+/// texels (a plain image read with `--env latlong`) to OpenEXR's. The
+/// pole rows of the written map hold what a centred reader finds at the
+/// poles (the first and last rows), so they are checked against that.
+#[test]
+fn lat_long_texels_are_placed_as_each_container_defines_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (256, 128);
+    let imf_of = |w: u32, h: u32| {
+        move |x: u32, y: u32| {
+            lat_long_direction(x as f64 / (w - 1) as f64, y as f64 / (h - 1) as f64)
+        }
+    };
+    let imf = imf_of(w, h);
+    let centred = |x: u32, y: u32| {
+        lat_long_direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64)
+    };
+    let ll = image_of(w, h, imf);
+    let exr = dir.path().join("imf_ll.exr");
+    io::exr::save_environment(
+        std::slice::from_ref(&ll),
+        parvo::mip::Rounding::Down,
+        &exr,
+        &io::SaveOptions::default(),
+        io::Environment::LatLong,
+    )
+    .unwrap();
+    let out = dir.path().join("imf_out.exr");
+    mip(&[s(&exr), "-o", s(&out)]);
+    let levels = load(&out).levels;
+    assert_eq!(levels[0], ll, "level 0 is written as it was read");
+    let (w1, h1) = (w / 2, h / 2);
+    // Rows two off the poles and nearer the equator (the rows next to a
+    // pole row mix in the pole's one value: 1.6e-3 there).
+    let rows = 2..h1 - 2;
+    let got = worst_against(&levels[1], rows.clone(), imf_of(w1, h1));
+    // Level 1 built from OpenEXR's texels read as centred and written as
+    // built: what parvo did before.
+    let old = latlong::build_chain(ll).unwrap().levels()[1].clone();
+    let before = worst_against(&old, rows, imf_of(w1, h1));
+    eprintln!("OpenEXR lat-long level 1: worst {got:.2e}; built as centred {before:.2e}");
+    assert!(got < 1e-3 && got * 5.0 < before, "{got} against {before}");
+
+    // maketx's centred lat-long to OpenEXR's.
+    let src = dir.path().join("centred.exr");
+    io::save(
+        &[image_of(w, h, centred)],
+        parvo::mip::Rounding::Down,
+        &src,
+        io::OutputKind::EXR,
+        &io::SaveOptions::default(),
+    )
+    .unwrap();
+    let out = dir.path().join("placed.exr");
+    mip(&[s(&src), "--env", "latlong", "-o", s(&out)]);
+    let back = load(&out);
+    assert_eq!(back.info.placement, Placement::Edges);
+    let back = back.base().clone();
+    let got = worst_against(&back, 1..h - 1, imf);
+    let written_as_is = worst_against(&image_of(w, h, centred), 1..h - 1, imf);
+    eprintln!(
+        "centred lat-long -> OpenEXR: worst {got:.2e} off the poles; as given {written_as_is:.2e}"
+    );
+    assert!(
+        got < 5e-4 && got * 10.0 < written_as_is,
+        "{got} against {written_as_is}"
+    );
+    // The pole rows: the first and last centred rows, resampled along
+    // the row (each value between two neighbours of that row).
+    let src_lin = image_of(w, h, centred).to_linear();
+    let lin = back.to_linear();
+    for (row, from) in [(0, 0), (h - 1, h - 1)] {
+        for x in 0..w {
+            let at = |r: u32, i: u32| &src_lin[((r * w + i % w) * 3) as usize..][..3];
+            let p = x as f64 * w as f64 / (w - 1) as f64 - 0.5;
+            let i0 = p.floor().rem_euclid(w as f64) as u32;
+            for c in 0..3 {
+                let (a, b) = (at(from, i0)[c], at(from, i0 + 1)[c]);
+                let v = lin[((row * w + x) * 3) as usize + c];
+                assert!(
+                    v >= a.min(b) - 1e-6 && v <= a.max(b) + 1e-6,
+                    "pole row {row} texel {x}: {v} not between {a} and {b}"
+                );
+            }
+        }
+    }
+}
+
+/// The direction `axis` (0, 1, 2 for x, y, z) with `sign`, plus `t` along
+/// world axis `other`.
+fn axis_plus(axis: usize, sign: f64, other: usize, t: f64) -> [f32; 3] {
+    let mut d = [0.0f32; 3];
+    d[axis] = sign as f32;
+    d[other] += t as f32;
+    d
+}
+
+/// The dark red or black of the axis glyphs OpenEXR's orientation maps
+/// draw (the text around them is light blue, the rest white).
+fn is_glyph(v: [f32; 4]) -> bool {
+    v[1] < 0.1 && v[2] < 0.1
+}
+
+/// How many lookups along each arm of each face's axis glyph are dark: for
+/// every face direction (±x, ±y, ±z) and each other world axis u, the
+/// counts along +u and along −u (6 lookups each).
+fn arm_counts(look: &dyn Fn([f32; 3]) -> [f32; 4]) -> Vec<(String, usize, usize)> {
+    let mut out = Vec::new();
+    for axis in 0..3 {
+        for sign in [1.0, -1.0] {
+            for other in (0..3).filter(|&o| o != axis) {
+                let count = |dir: f64| {
+                    (1..=6)
+                        .filter(|&k| {
+                            is_glyph(look(axis_plus(axis, sign, other, dir * 0.05 * k as f64)))
+                        })
+                        .count()
+                };
+                let name = format!(
+                    "{}{} face, toward {}",
+                    if sign > 0.0 { "+" } else { "-" },
+                    ["x", "y", "z"][axis],
+                    ["x", "y", "z"][other]
+                );
+                out.push((name, count(1.0), count(-1.0)));
+            }
+        }
+    }
+    out
+}
+
+/// OpenEXR's `OrientationCube.exr` and `OrientationLatLong.exr` draw, in
+/// the direction of each axis, a glyph whose two dark arms point
+/// along the positive directions of the other two axes (`ImfEnvmap.h`:
+/// "+X face: Y up, Z right", ...). Read as OpenEXR defines them, every
+/// arm is where OpenEXR says, in both files; the strip's faces read as
+/// GL's (unmirrored) put the arms of the X and Z faces the wrong way.
+#[test]
+fn openexr_orientation_maps_show_each_axis_where_openexr_says() {
+    let cube_src = interpret(load(&openexr_image("OrientationCube.exr")), "c", None).unwrap();
+    let cube = cube_sampler(&cube_src.images, cube_src.placement);
+    let ll_src = interpret(load(&openexr_image("OrientationLatLong.exr")), "l", None).unwrap();
+    let ll_chain = MipChain::from_levels(
+        vec![ll_src.images[0][0].clone()],
+        parvo::MipOptions::default(),
+    )
+    .unwrap();
+    let ll = LatLongSampler::new(&ll_chain, level0_bilinear())
+        .unwrap()
+        .with_placement(ll_src.placement);
+    for (file, counts) in [
+        ("cube", arm_counts(&|d| cube.sample(&DirQuery::point(d)))),
+        ("lat-long", arm_counts(&|d| ll.sample(&DirQuery::point(d)))),
+    ] {
+        for (name, along, against) in counts {
+            assert!(
+                along == 6 && against == 0,
+                "{file} {name}: {along} of 6 lookups dark along the arm, {against} the other way"
+            );
+        }
+    }
+    // GL's reading of the strip: faces unmirrored, texels centred.
+    let strip = load(&openexr_image("OrientationCube.exr")).base().clone();
+    let gl: Vec<Vec<Texture>> = parvo::env::cube::faces_from_strip(&strip)
+        .unwrap()
+        .into_iter()
+        .map(|f| vec![f])
+        .collect();
+    let gl = cube_sampler(&gl, Placement::Centred);
+    let wrong = arm_counts(&|d| gl.sample(&DirQuery::point(d)))
+        .into_iter()
+        .filter(|(_, along, against)| *along < 5 || *against > 0)
+        .count();
+    assert!(wrong >= 4, "GL's reading puts only {wrong} arms wrong");
+}

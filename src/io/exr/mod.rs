@@ -52,9 +52,11 @@ use crate::mip::Rounding;
 use crate::texel::{AlphaMode, ChannelType, ColorSpace, Format, Texels};
 use crate::texture::Texture;
 
+mod placement;
 mod read;
 mod write;
 
+pub use placement::{centred_from_edges, edges_from_centred};
 pub use read::*;
 pub use write::*;
 
@@ -277,6 +279,9 @@ impl super::Container for OpenExr {
             ImageKind::Plain | ImageKind::LatLong | ImageKind::Cube
         )
     }
+    fn placement(&self) -> crate::env::Placement {
+        crate::env::Placement::Edges
+    }
     fn save(
         &self,
         images: &[&[Texture]],
@@ -288,6 +293,15 @@ impl super::Container for OpenExr {
         use crate::texture::ImageKind;
         match kind {
             ImageKind::Plain => save(images[0], rounding, path, options),
+            _ if options.placement == crate::env::Placement::Centred => {
+                let placed = edges_from_centred(images, kind, 0)?;
+                let refs: Vec<&[Texture]> = placed.iter().map(Vec::as_slice).collect();
+                let options = SaveOptions {
+                    placement: crate::env::Placement::Edges,
+                    ..options.clone()
+                };
+                self.save(&refs, kind, rounding, path, &options)
+            }
             ImageKind::LatLong => save_environment(
                 images[0],
                 rounding,

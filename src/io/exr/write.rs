@@ -21,7 +21,9 @@ pub fn save(levels: &[Texture], rounding: Rounding, path: &Path, opts: &SaveOpti
 /// faces stacked top to bottom (+X, −X, +Y, −Y, +Z, −Z) in every level,
 /// marked with OpenEXR's `envmap` attribute and maketx's `textureformat`
 /// (`LatLong Environment`, `CubeFace Environment`), as `maketx --envlatl`
-/// and `--envcube` write them.
+/// and `--envcube` write them. The texels are written as given: placed
+/// as OpenEXR places them ([`super::edges_from_centred`] makes them so
+/// from centred texels; the container's `save` does it for you).
 pub fn save_environment(
     levels: &[Texture],
     rounding: Rounding,
