@@ -215,6 +215,12 @@ pub trait Container: Send + Sync {
     fn placement(&self) -> crate::env::Placement {
         crate::env::Placement::Centred
     }
+    /// Refuses an output name `path` that cannot name an image of `kind`
+    /// in this container (one PNG per level needs `{face}` or `{layer}`
+    /// to tell a cube map's faces or an array's layers apart).
+    fn check_path(&self, _path: &Path, _kind: ImageKind) -> Result<()> {
+        Ok(())
+    }
 }
 
 fn cannot_hold(name: &str, kind: ImageKind, path: &Path) -> Error {
@@ -411,6 +417,12 @@ impl OutputKind {
         self.0.placement()
     }
 
+    /// Refuses an output name that cannot name an image of `kind` in
+    /// this container (PNG levels of a cube map without `{face}`).
+    pub fn check_path(self, path: &Path, kind: ImageKind) -> Result<()> {
+        self.0.check_path(path, kind)
+    }
+
     /// Display name of the container ("OpenEXR", "PNG", ...).
     pub fn name(self) -> &'static str {
         self.0.name()
@@ -547,6 +559,7 @@ fn check_images(count: usize, image_kind: ImageKind, path: &Path, kind: OutputKi
     if !kind.holds(image_kind) {
         return Err(cannot_hold(kind.name(), image_kind, path));
     }
+    kind.check_path(path, image_kind)?;
     if count != image_kind.images() {
         return Err(Error::InvalidOption(format!(
             "a {} holds {} images, got {count}",

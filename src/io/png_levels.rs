@@ -1,14 +1,18 @@
 //! One PNG per mip level: an output name containing `{level}` (e.g.
 //! `out_{level}.png`) becomes `out_0.png`, `out_1.png`, ... 8- or 16-bit,
-//! 1–4 channels as stored. All files are staged first and renamed only when
-//! every level has been encoded (see [`atomic`]).
+//! 1–4 channels as stored. A cube map's faces go to the names `{face}`
+//! makes (`px`, `nx`, `py`, `ny`, `pz`, `nz`: +X, −X, +Y, −Y, +Z, −Z, the
+//! names six face files are usually given), an array's layers to those
+//! `{layer}` makes (`0`, `1`, ...). All files are staged first and renamed
+//! only when every level of every image has been encoded (see
+//! [`atomic`]).
 
 use std::path::{Path, PathBuf};
 
 use super::atomic;
 use crate::error::{Error, Result};
 use crate::texel::{ColorSpace, Texels};
-use crate::texture::Texture;
+use crate::texture::{ImageKind, Texture};
 
 fn encode_err(reason: impl std::fmt::Display) -> Error {
     Error::Encode {
@@ -24,6 +28,31 @@ pub fn level_path(template: &Path, k: usize) -> PathBuf {
             .to_string_lossy()
             .replace("{level}", &k.to_string()),
     )
+}
+
+/// The names `{face}` takes in a cube map's file names, in face order.
+pub const FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
+
+/// The placeholder that tells an image of `kind` apart from the others
+/// of its texture in a file name: `{face}` for a cube map, `{layer}` for
+/// an array; none for one image.
+fn placeholder(kind: ImageKind) -> Option<&'static str> {
+    match kind {
+        ImageKind::Cube => Some("{face}"),
+        ImageKind::Array { layers } if layers > 1 => Some("{layer}"),
+        _ => None,
+    }
+}
+
+/// The `{level}` template of image `i` (a face or a layer) of a texture
+/// of `kind` written to `template`.
+pub fn image_template(template: &Path, kind: ImageKind, i: usize) -> PathBuf {
+    let name = template.to_string_lossy();
+    PathBuf::from(match placeholder(kind) {
+        Some("{face}") => name.replace("{face}", FACE_NAMES[i % 6]),
+        Some(p) => name.replace(p, &i.to_string()),
+        None => name.into_owned(),
+    })
 }
 
 /// Encode one texture as PNG into `out`, with the chunk that says its
@@ -72,11 +101,20 @@ pub const SOFTWARE: &str = concat!("parvo ", env!("CARGO_PKG_VERSION"));
 
 /// Write every level to its own PNG, atomically as a set.
 pub fn save(levels: &[Texture], template: &Path) -> Result<()> {
-    let mut staged = Vec::with_capacity(levels.len());
-    for (k, l) in levels.iter().enumerate() {
-        staged.push(atomic::stage(&level_path(template, k), |w| {
-            write_png(l, w)
-        })?);
+    save_images(&[levels], ImageKind::Plain, template)
+}
+
+/// Write every level of every image (faces or layers of a texture of
+/// `kind`) to its own PNG, atomically as a set.
+fn save_images(images: &[&[Texture]], kind: ImageKind, template: &Path) -> Result<()> {
+    let mut staged = Vec::new();
+    for (i, levels) in images.iter().enumerate() {
+        let template = image_template(template, kind, i);
+        for (k, l) in levels.iter().enumerate() {
+            staged.push(atomic::stage(&level_path(&template, k), |w| {
+                write_png(l, w)
+            })?);
+        }
     }
     for s in staged {
         s.commit()?;
@@ -161,6 +199,27 @@ impl super::Container for PngLevels {
     fn output_hint(&self) -> String {
         "a name with {level} for one PNG per level".into()
     }
+    fn holds(&self, kind: ImageKind) -> bool {
+        matches!(
+            kind,
+            ImageKind::Plain | ImageKind::LatLong | ImageKind::Cube | ImageKind::Array { .. }
+        )
+    }
+    fn check_path(&self, path: &Path, kind: ImageKind) -> Result<()> {
+        match placeholder(kind) {
+            Some(p) if !path.to_string_lossy().contains(p) => Err(Error::InvalidOption(format!(
+                "the name needs {p} as well as {{level}} for one PNG per level of a {} (e.g. \
+                 `sky_{p}_{{level}}.png`{})",
+                kind.describe(),
+                if kind == ImageKind::Cube {
+                    ": {face} becomes px nx py ny pz nz"
+                } else {
+                    ""
+                }
+            ))),
+            _ => Ok(()),
+        }
+    }
     fn batch_path(&self, dir: &Path, stem: &str) -> PathBuf {
         dir.join(format!("{stem}_{{level}}.png"))
     }
@@ -175,11 +234,11 @@ impl super::Container for PngLevels {
     fn save(
         &self,
         images: &[&[Texture]],
-        _kind: crate::texture::ImageKind,
+        kind: ImageKind,
         _rounding: crate::mip::Rounding,
         path: &Path,
         _options: &super::SaveOptions,
     ) -> Result<()> {
-        save(images[0], path)
+        save_images(images, kind, path)
     }
 }

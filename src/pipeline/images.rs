@@ -422,6 +422,7 @@ fn check_kind(
     if !job.kind.holds(target) {
         return Err(kind_not_stored(target, job.kind));
     }
+    job.kind.check_path(&job.output, target)?;
     let environment = target.is_cube() || target == ImageKind::LatLong;
     if s.roughness.is_some() {
         return not(

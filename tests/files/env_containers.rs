@@ -1077,3 +1077,60 @@ fn openexr_images_environments_round_trip() {
         }
     }
 }
+
+/// An 8-bit sRGB cube map and array as one PNG per face (or layer) and
+/// level: the names `{face}` (px nx py ny pz nz) and `{layer}` make, the
+/// texels those of the KTX2 the same command writes (sRGB u8 both), and
+/// a name without the placeholder refused before anything is built.
+#[test]
+fn srgb_cube_maps_and_arrays_go_to_png_faces_and_layers() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    for (name, template, count) in [
+        ("valid_R8G8B8A8_SRGB_CUBE", "cube_{face}_{level}.png", 6),
+        ("valid_R8G8B8A8_SRGB_2D_ARRAY", "arr_{layer}_{level}.png", 0),
+    ] {
+        let src = cts(&format!("{name}.ktx2"));
+        let src = src.to_str().unwrap();
+        let ktx2 = p(&format!("{name}.ktx2"));
+        let o = parvo(&["mip", src, "-o", &ktx2]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let want = load(Path::new(&ktx2)).into_images();
+        let count = if count == 0 { want.len() } else { count };
+        assert_eq!(want.len(), count, "{name}");
+        let o = parvo(&["mip", src, "-o", &p(template)]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let names: Vec<String> = if template.contains("{face}") {
+            ["px", "nx", "py", "ny", "pz", "nz"]
+                .iter()
+                .map(|f| template.replace("{face}", f))
+                .collect()
+        } else {
+            (0..count)
+                .map(|i| template.replace("{layer}", &i.to_string()))
+                .collect()
+        };
+        for (i, levels) in want.iter().enumerate() {
+            for (k, level) in levels.iter().enumerate() {
+                let file = p(&names[i].replace("{level}", &k.to_string()));
+                let got = load(Path::new(&file)).into_base();
+                assert_eq!(got.format().color_space, ColorSpace::Srgb, "{file}");
+                assert_eq!(
+                    (got.width(), got.height(), bytes(&got)),
+                    (level.width(), level.height(), bytes(level)),
+                    "{file}"
+                );
+            }
+            let past = names[i].replace("{level}", &levels.len().to_string());
+            assert!(!Path::new(&p(&past)).exists(), "{past}");
+        }
+        // Without the placeholder: refused, nothing written.
+        let plain = p(&format!("{name}_flat_{{level}}.png"));
+        let o = parvo(&["mip", src, "-o", &plain]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{name}: {err}");
+        let wanted = if count == 6 { "{face}" } else { "{layer}" };
+        assert!(err.contains(wanted), "{name}: {err}");
+        assert!(!Path::new(&plain.replace("{level}", "0")).exists());
+    }
+}
