@@ -567,6 +567,8 @@ fn read_as(f: Format, s: &Settings) -> Format {
     let mut src = f;
     src.color_space = match (s.color, s.normal_map) {
         (ColorChoice::Linear, _) | (ColorChoice::Auto, true) => ColorSpace::Linear,
+        // An output that holds data keeps the stored codes.
+        (ColorChoice::Auto, false) if holds_data(s) => ColorSpace::Linear,
         (ColorChoice::Srgb, _) => ColorSpace::Srgb,
         // The loader's reading of the file (see io::load).
         (ColorChoice::Auto, false) => src.color_space,
@@ -587,10 +589,27 @@ fn read_as(f: Format, s: &Settings) -> Format {
 /// linear output).
 fn load_notes(loaded: &io::Loaded, s: &Settings) -> Vec<Note> {
     let mut notes: Vec<Note> = loaded.info.notes.iter().cloned().map(Note::Text).collect();
-    if s.color == ColorChoice::Auto && !s.normal_map {
-        notes.extend(io::assumed_color_note(&loaded.info, &loaded.base().format()).map(Note::Text));
+    let f = loaded.base().format();
+    match s.compress {
+        _ if s.color != ColorChoice::Auto || s.normal_map => {}
+        Some((bf, _)) if bf.holds_data() => {
+            if f.color_space == ColorSpace::Srgb && !f.channel_type.is_float() {
+                notes.push(Note::Text(format!(
+                    "{bf} holds data: the file's stored codes are kept as they are, not \
+                     decoded from sRGB ({} srgb decodes them to linear first)",
+                    crate::setting::Setting::Color
+                )));
+            }
+        }
+        _ => notes.extend(io::assumed_color_note(&loaded.info, &f).map(Note::Text)),
     }
     notes
+}
+
+/// True when the output holds data rather than colour (BC4, BC5): the
+/// input's codes are read as they are stored.
+fn holds_data(s: &Settings) -> bool {
+    s.compress.is_some_and(|(bf, _)| bf.holds_data())
 }
 
 /// `base` resized as [`Settings::resize_to`] asks (with the wrap modes

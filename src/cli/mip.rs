@@ -578,6 +578,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
         started: Instant::now(),
         failed: Mutex::new(0),
         print: Mutex::new(()),
+        seen: Mutex::new(Vec::new()),
     };
     let single = jobs.first().map(|j| (j.input.clone(), j.output.clone()));
     let mut progress = |stage: Stage| {
@@ -591,6 +592,7 @@ pub fn run(args: MipArgs) -> anyhow::Result<ExitCode> {
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
+    out.repeats();
     let failed = *out.failed.lock().unwrap_or_else(|e| e.into_inner());
     Ok(if failed == 0 {
         ExitCode::SUCCESS
@@ -699,9 +701,40 @@ struct Printer<'a> {
     started: Instant,
     failed: Mutex<usize>,
     print: Mutex<()>,
+    /// A batch's notes said so far: each distinct text, the input it was
+    /// said for, and how many inputs it concerns.
+    seen: Mutex<Vec<(String, String, usize)>>,
 }
 
 impl Printer<'_> {
+    /// A note for `input`: said at once, except in a batch, where a note
+    /// already said for another input is only counted
+    /// ([`Printer::repeats`] says the counts at the end).
+    fn note(&self, input: &str, text: String) {
+        if self.batch {
+            let mut seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(s) = seen.iter_mut().find(|s| s.0 == text) {
+                s.2 += 1;
+                return;
+            }
+            seen.push((text.clone(), input.to_string(), 1));
+        }
+        self.warn(format!("parvo: {input}: {text}"));
+    }
+
+    /// After a batch: how many inputs each repeated note concerned.
+    fn repeats(&self) {
+        let seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        for (text, first, n) in seen.iter().filter(|s| s.2 > 1) {
+            let short: String = text.chars().take(60).collect();
+            let more = if short.len() < text.len() { "…" } else { "" };
+            self.warn(format!(
+                "parvo: the note for {first} (\"{short}{more}\") concerns {n} inputs in all \
+                 (--json lists each input's notes)"
+            ));
+        }
+    }
+
     fn line(&self, s: String) {
         match self.bar {
             Some(b) => b.suspend(|| println!("{s}")),
@@ -730,7 +763,7 @@ impl Printer<'_> {
                     secs
                 };
                 for n in &o.notes {
-                    self.warn(format!("parvo: {}: {}", job.input, note_text(n)));
+                    self.note(&job.input, note_text(n));
                 }
                 if args.json {
                     self.line(json_line(job, &o, secs));

@@ -124,6 +124,13 @@ impl BlockFormat {
         }
     }
 
+    /// True for the formats that hold data rather than colour: BC4 and
+    /// BC5 have no sRGB variant and store roughness, heights, masks and
+    /// normals, so an input's stored codes go into them as they are.
+    pub fn holds_data(self) -> bool {
+        matches!(self, BlockFormat::Bc4 { .. } | BlockFormat::Bc5 { .. })
+    }
+
     /// Bytes of a `w × h` level: whole blocks, at least one.
     pub fn level_bytes(self, w: u32, h: u32) -> u64 {
         (w.div_ceil(4).max(1) as u64) * (h.div_ceil(4).max(1) as u64) * self.block_bytes() as u64

@@ -282,3 +282,115 @@ fn cachesim_counts_blocks_of_compressed_files() {
     );
     assert!(bc * 2 < bu, "BC7 {bc} bytes, RGBA8 {bu}");
 }
+
+/// A grey PNG that says nothing of its colour, written with the `png`
+/// crate alone (no sRGB, gAMA or iCCP chunk): smooth with some noise,
+/// like a height or roughness map.
+fn untagged_grey_png(path: &Path, w: u32, h: u32) -> Vec<u8> {
+    let mut s = 0x2545_f491_4f6c_dd1du64;
+    let codes: Vec<u8> = (0..w * h)
+        .map(|i| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let (x, y) = ((i % w) as f64, (i / w) as f64);
+            let v = 128.0 + 90.0 * (x / 9.0).sin() * (y / 13.0).cos() + (s % 17) as f64 - 8.0;
+            v.clamp(0.0, 255.0) as u8
+        })
+        .collect();
+    let file = std::fs::File::create(path).unwrap();
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), w, h);
+    enc.set_color(png::ColorType::Grayscale);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut wr = enc.write_header().unwrap();
+    wr.write_image_data(&codes).unwrap();
+    wr.finish().unwrap();
+    codes
+}
+
+/// BC4 holds data: an untagged grey PNG goes in as its stored codes with
+/// no flag (as nvcompress, etcpak and quicktex keep them), said once on
+/// stderr; `--color srgb` still decodes it (the old default, far off the
+/// codes). The blocks are decoded by `bcdec_rs`, not by parvo.
+#[test]
+fn bc4_keeps_the_stored_codes_of_an_untagged_grey_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let (w, h) = (61, 37);
+    let src = dir.path().join("height.png");
+    let codes = untagged_grey_png(&src, w, h);
+    let psnr = |extra: &[&str]| {
+        let out = dir.path().join(format!("bc4_{}.dds", extra.len()));
+        let mut args = vec!["mip", p(&src), "--compress", "bc4", "--levels", "1"];
+        args.extend_from_slice(extra);
+        args.extend(["-o", p(&out)]);
+        let o = parvo(&args);
+        ok(&o);
+        let data = std::fs::read(&out).unwrap();
+        let start = 4 + 124 + if &data[84..88] == b"DX10" { 20 } else { 0 };
+        let (bw, bh) = (w.div_ceil(4) as usize, h.div_ceil(4) as usize);
+        let mut se = 0.0f64;
+        for by in 0..bh {
+            for bx in 0..bw {
+                let off = start + (by * bw + bx) * 8;
+                let mut texels = [0u8; 16];
+                bcdec_rs::bc4(&data[off..off + 8], &mut texels, 4, false);
+                for j in 0..4 {
+                    for i in 0..4 {
+                        let (x, y) = (bx * 4 + i, by * 4 + j);
+                        if x < w as usize && y < h as usize {
+                            let d = texels[j * 4 + i] as f64 - codes[y * w as usize + x] as f64;
+                            se += d * d;
+                        }
+                    }
+                }
+            }
+        }
+        let mse = se / (w * h) as f64;
+        (
+            10.0 * (255.0f64 * 255.0 / mse.max(1e-12)).log10(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (kept, said) = psnr(&[]);
+    let (decoded, _) = psnr(&["--color", "srgb"]);
+    eprintln!("BC4 of an untagged grey PNG: {kept:.2} dB; read as sRGB colour {decoded:.2} dB");
+    assert!(kept > 40.0 && decoded < 25.0, "{kept} / {decoded}");
+    assert_eq!(said.matches("holds data").count(), 1, "{said}");
+}
+
+/// A batch says each distinct note once, for the first input it concerns,
+/// and at the end how many inputs it concerned: three untagged grey PNGs
+/// give the colour note once (to BC4, the note that the codes are kept).
+#[test]
+fn a_batch_says_each_note_once_with_its_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs: Vec<String> = (0..3)
+        .map(|i| {
+            let path = dir.path().join(format!("g{i}.png"));
+            untagged_grey_png(&path, 20 + i, 12);
+            p(&path).to_string()
+        })
+        .collect();
+    for (extra, phrase) in [
+        (vec![], "does not say how its values encode colour"),
+        (vec!["--compress", "bc4"], "holds data"),
+    ] {
+        let out = dir.path().join(format!("out{}", extra.len()));
+        let mut args: Vec<&str> = vec!["mip"];
+        args.extend(inputs.iter().map(String::as_str));
+        args.extend(extra.iter().copied());
+        args.extend(["--out-dir", p(&out), "--ext", "ktx2"]);
+        let o = parvo(&args);
+        ok(&o);
+        let err = String::from_utf8_lossy(&o.stderr);
+        let said = err
+            .lines()
+            .filter(|l| l.contains(phrase) && !l.contains("concerns"))
+            .count();
+        assert_eq!(said, 1, "{err}");
+        let counted = err
+            .lines()
+            .filter(|l| l.contains("concerns 3 inputs in all"));
+        assert_eq!(counted.count(), 1, "{err}");
+    }
+}
