@@ -9,6 +9,8 @@
 //!   BC1 blocks and BC3 colour halves at `normal` and `slow` (ISPC's
 //!   kernel has no settings, so `fast` and `normal` were once the same
 //!   bytes);
+//! - a one-channel fit of our own (the private `single` module), which
+//!   refits ISPC's BC4 blocks and BC5 halves at `normal` and `slow`;
 //! - `texpresso` (a port of libsquish) for BC1 with alpha (its one-bit
 //!   punch-through mode: texels with alpha below 128 become transparent,
 //!   which ISPC's BC1 does not encode; range fit, cluster fit and
@@ -46,6 +48,7 @@ use crate::texel::{AlphaMode, Texels};
 use crate::texture::Texture;
 
 mod colour;
+mod single;
 
 fn encode_err(reason: impl Into<String>) -> Error {
     Error::Encode {
@@ -136,6 +139,9 @@ pub fn encode(format: BlockFormat, quality: Quality, level: &Texture) -> Result<
                     }
                 }
             });
+            if format.holds_data() && quality != Quality::Fast {
+                refine_single(v, w, h, ch, format, quality, &mut out);
+            }
             if matches!(format, BlockFormat::Bc1 | BlockFormat::Bc3) && quality != Quality::Fast {
                 refine_colour(
                     v,
@@ -262,6 +268,41 @@ fn colour_effort(quality: Quality) -> colour::Effort {
 /// `slow` libsquish's iterative cluster fit (texpresso) too. `v` is the
 /// level's RGBA texels; `by_alpha` weighs each texel's colour error by its
 /// straight alpha (BC3).
+/// ISPC's BC4 blocks (BC5's two halves: R, then G) refitted
+/// ([`single::refine`]), block rows on all threads.
+fn refine_single(
+    v: &[u8],
+    w: usize,
+    h: usize,
+    ch: usize,
+    format: BlockFormat,
+    quality: Quality,
+    out: &mut [u8],
+) {
+    let radius = if quality == Quality::Slow { 4 } else { 1 };
+    let bb = format.block_bytes();
+    let bw = w.div_ceil(4);
+    out.par_chunks_mut(bw * bb)
+        .enumerate()
+        .for_each(|(by, row)| {
+            for (bx, blk) in row.chunks_exact_mut(bb).enumerate() {
+                for c in 0..bb / 8 {
+                    let mut values = [0u8; 16];
+                    let mut mask = 0u16;
+                    for (i, value) in values.iter_mut().enumerate() {
+                        let (x, y) = (bx * 4 + i % 4, by * 4 + i / 4);
+                        if x < w && y < h {
+                            mask |= 1 << i;
+                        }
+                        let (x, y) = (x.min(w - 1), y.min(h - 1));
+                        *value = v[(y * w + x) * ch + c];
+                    }
+                    single::refine(&values, mask, radius, &mut blk[c * 8..c * 8 + 8]);
+                }
+            }
+        });
+}
+
 fn refine_colour(
     v: &[u8],
     w: usize,
