@@ -177,6 +177,8 @@ def reference(entry):
         f = a.astype(np.float32)
         with np.errstate(over="ignore"):
             a = np.concatenate([f[:, :, :-1] * f[:, :, -1:], f[:, :, -1:]], axis=2).astype(np.float64)
+    if a is not None and entry.get("ref_transform") == "invert":
+        a = 1.0 - a
     if a is not None and entry.get("ref_transform") == "snorm8_biased":
         # Pillow stores signed (SNORM) BC4/BC5 codes c in -127..127 as
         # c + 128; the value they stand for is max(c / 127, -1).

@@ -34,9 +34,14 @@
 //! interleaved), in strips or tiles. 1- to 7-bit grey widens to u8 as
 //! OpenImageIO widens it (`v · 255 / (2^bits − 1)` rounded down: 0 → 0,
 //! the largest code → 255). `FillOrder` 2 is read for uncompressed data.
-//! CMYK, YCbCr, Lab, LogLuv, signed, 10-, 12-, 14-, 24- and 32-bit
-//! integer samples, sub-byte colour and compressions the crate lacks
-//! (LZMA, WebP, Zstandard, CCITT Group 3) are refused in plain words.
+//! Samples of other sizes (1–7 bits of several channels, 9–15, 17–31) and
+//! YCbCr outside JPEG are unpacked by parvo (`tiff/raw.rs`); 24- and
+//! 32-bit unsigned and signed integers load as f32 (v / the type's
+//! maximum, OpenImageIO's float reading); CMYK of four 8- or 16-bit inks
+//! and JPEG's YCbCr convert to RGB as OpenImageIO converts them. Lab,
+//! LogL/LogLuv, old-style JPEG, other inks and compressions the crate
+//! lacks (LZMA, WebP, Zstandard, CCITT Group 3) are refused in plain
+//! words that say what to convert the file to.
 //! TIFF carries no transfer function parvo reads, so `--color auto` takes
 //! its texels as linear.
 //!
@@ -48,6 +53,7 @@
 
 mod chain;
 mod errors;
+mod raw;
 
 use std::fs::File;
 use std::io::{BufReader, Read, Seek};
@@ -59,6 +65,7 @@ use ::tiff::{TiffError, TiffFormatError};
 
 use self::chain::{Fix, tag};
 use self::errors::{alloc_limit, words};
+use self::raw::{View, Ycc};
 use super::{Environment, FileFormat, Limits, LoadOptions, Loaded, SourceInfo};
 use crate::error::{Error, Result};
 use crate::mip::Rounding;
@@ -97,6 +104,24 @@ struct Directory {
     palette: Option<Vec<u16>>,
     /// FillOrder 2: the bits of every byte are stored in reverse order.
     bit_reversed: bool,
+    /// Samples parvo unpacks itself (see `tiff/raw.rs`).
+    view: Option<View>,
+    /// The colour conversion to RGB the stored samples need.
+    convert: Convert,
+}
+
+/// A conversion to RGB of samples the decoder returns as stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Convert {
+    None,
+    /// CMYK, converted as OpenImageIO converts it (`cmyk_to_rgb`:
+    /// R = (1 − C)(1 − K) in float, rounded to the nearest code).
+    Cmyk,
+    /// CMYK in JPEG, which OpenImageIO reads through libtiff's RGBA
+    /// interface: R = (255 − K)(255 − C) / 255 rounded down.
+    CmykJpeg,
+    /// YCbCr in JPEG, converted as libjpeg converts it for libtiff.
+    YccJpeg,
 }
 
 impl Directory {
@@ -147,6 +172,9 @@ impl Reader<'_> {
     }
 
     fn directory<R: Read + Seek>(&self, d: &mut Decoder<R>, fix: Fix) -> Result<Directory> {
+        if let Some(v) = fix.view {
+            return self.view_directory(d, v);
+        }
         let (width, height) = d.dimensions().map_err(|e| self.err(e))?;
         let stored_samples = self.unsigned(d, Tag::SamplesPerPixel)?.unwrap_or(1) as usize;
         let bits: Vec<u16> = d
@@ -184,7 +212,9 @@ impl Reader<'_> {
             Some(p) => p,
             None => fix.told.unwrap_or(1) as u64,
         };
-        let colour = colour_channels(photometric, stored_samples, bits)?;
+        let compression = self.unsigned(d, Tag::Compression)?.unwrap_or(1);
+        let convert = self.conversion(d, photometric, compression, stored_samples, bits)?;
+        let colour = colour_channels(photometric, stored_samples, bits, compression)?;
         let bit_reversed = self.bit_reversed(d)?;
         if !(1..=4).contains(&stored_samples) || stored_samples < colour {
             return Err(decode_err(format!(
@@ -197,7 +227,8 @@ impl Reader<'_> {
             None
         };
         let ty = channel_type(sample_format, bits, stored_samples, palette.is_some())?;
-        let has_alpha_slot = stored_samples == 2 || stored_samples == 4;
+        let has_alpha_slot =
+            (stored_samples == 2 || stored_samples == 4) && convert == Convert::None;
         let (alpha, alpha_note) = if missing && stored_samples == 2 && extra.is_empty() {
             // OpenImageIO reads two untagged channels as R, G data.
             (AlphaMode::None, None)
@@ -222,7 +253,7 @@ impl Reader<'_> {
                         "the fourth channel is not alpha (ExtraSamples 0) and is not read; RGB is",
                     ),
                 )
-            } else if palette.is_some() {
+            } else if palette.is_some() || convert != Convert::None {
                 (3, alpha_note)
             } else {
                 (stored_samples, alpha_note)
@@ -247,7 +278,115 @@ impl Reader<'_> {
             alpha_note,
             palette,
             bit_reversed,
+            view: None,
+            convert,
         })
+    }
+
+    /// A directory whose samples parvo unpacks (see `tiff/raw.rs`): what
+    /// the file stores, not the rows of bytes the decoder is told of.
+    fn view_directory<R: Read + Seek>(&self, d: &mut Decoder<R>, v: View) -> Result<Directory> {
+        let stored_samples = v.samples as usize;
+        let colour = if v.photometric == 2 || v.is_ycbcr() {
+            3
+        } else {
+            1
+        };
+        if stored_samples < colour {
+            return Err(decode_err(format!(
+                "{stored_samples} samples per pixel for a colour image"
+            )));
+        }
+        let ty = match v.bits {
+            _ if v.is_ycbcr() => ChannelType::U8,
+            0..=8 => ChannelType::U8,
+            9..=16 => ChannelType::U16,
+            _ => ChannelType::F32,
+        };
+        let has_alpha_slot = stored_samples == 2 || stored_samples == 4;
+        let (alpha, alpha_note) = if stored_samples > colour && has_alpha_slot {
+            extra_alpha(v.extra, true)
+        } else {
+            (AlphaMode::Straight, None)
+        };
+        let samples = if v.is_ycbcr() { 3 } else { stored_samples };
+        let tile = self
+            .raw
+            .unsigned(&self.layout, tag::TILE_WIDTH)
+            .zip(self.raw.unsigned(&self.layout, tag::TILE_LENGTH))
+            .map(|(w, h)| (w as u32, h as u32));
+        Ok(Directory {
+            width: v.width,
+            height: v.height,
+            format: Format::new(samples as u8, ty, ColorSpace::Linear).with_alpha(alpha),
+            samples,
+            stored_samples,
+            bits: v.bits,
+            planar: v.planar,
+            tile,
+            orientation: self.unsigned(d, Tag::Orientation)?.unwrap_or(1) as u16,
+            alpha_note,
+            palette: None,
+            bit_reversed: self.bit_reversed(d)?,
+            view: Some(v),
+            convert: Convert::None,
+        })
+    }
+
+    /// The conversion to RGB that photometric interpretation
+    /// `photometric` needs: CMYK (four 8- or 16-bit inks, `InkSet` CMYK)
+    /// and JPEG-compressed YCbCr; other CMYK is refused in words.
+    fn conversion<R: Read + Seek>(
+        &self,
+        d: &mut Decoder<R>,
+        photometric: u64,
+        compression: u32,
+        stored_samples: usize,
+        bits: u16,
+    ) -> Result<Convert> {
+        let jpeg = compression == 7;
+        match photometric {
+            5 => {
+                let inks = self.unsigned(d, Tag::Unknown(332))?.unwrap_or(1);
+                let format = d
+                    .find_tag_unsigned_vec::<u16>(Tag::SampleFormat)
+                    .map_err(|e| self.err(e))?
+                    .and_then(|v| v.first().copied())
+                    .unwrap_or(1);
+                if inks != 1 {
+                    return Err(decode_err(format!(
+                        "a colour-separated TIFF of {stored_samples} inks that are not CMYK \
+                         (InkSet {inks}) is not supported: convert it to RGB"
+                    )));
+                }
+                if stored_samples != 4 {
+                    return Err(decode_err(format!(
+                        "CMYK TIFF with {stored_samples} samples per pixel is not supported (4 \
+                         inks, C, M, Y and K, are): convert it to RGB or RGBA"
+                    )));
+                }
+                if format != 1 || !matches!(bits, 8 | 16) || (jpeg && bits != 8) {
+                    return Err(decode_err(format!(
+                        "CMYK TIFF of {bits}-bit {} samples is not supported (8- and 16-bit \
+                         unsigned inks are): convert it to RGB",
+                        if format == 2 {
+                            "signed"
+                        } else if format == 3 {
+                            "float"
+                        } else {
+                            "integer"
+                        }
+                    )));
+                }
+                Ok(if jpeg {
+                    Convert::CmykJpeg
+                } else {
+                    Convert::Cmyk
+                })
+            }
+            6 if jpeg && stored_samples == 3 && bits == 8 => Ok(Convert::YccJpeg),
+            _ => Ok(Convert::None),
+        }
     }
 
     /// `FillOrder` 2 stores the bits of each byte in reverse; libtiff
@@ -351,6 +490,20 @@ impl Reader<'_> {
         let (w, h) = (dir.width as usize, dir.height as usize);
         let n = w * h;
         let err = |e| words(e, Some(self.raw), &self.layout, self.limits, Some(dir));
+        if let Some(v) = &dir.view {
+            if v.texel_bytes() > self.limits.max_alloc {
+                return Err(alloc_limit(self.limits, dir, v.texel_bytes()));
+            }
+            let mut result = DecodingResult::U8(Vec::new());
+            d.read_image_to_buffer(&mut result).map_err(err)?;
+            let mut buffer = result.as_buffer(0);
+            let bytes = buffer.as_bytes_mut();
+            if dir.bit_reversed {
+                bytes.iter_mut().for_each(|b| *b = b.reverse_bits());
+            }
+            let texels = v.decode(bytes).map_err(decode_err)?;
+            return Texture::from_texels(dir.width, dir.height, dir.format, texels);
+        }
         let sample_bytes = (dir.bits as usize).div_ceil(8);
         let (mut result, per_pixel) = if dir.planar && dir.tile.is_some() && dir.stored_samples > 1
         {
@@ -382,10 +535,10 @@ impl Reader<'_> {
             }
         }
         // Channels decoded per pixel and kept (a palette has one index).
-        let keep = if dir.palette.is_some() {
-            1
-        } else {
-            dir.samples
+        let keep = match dir.convert {
+            _ if dir.palette.is_some() => 1,
+            Convert::Cmyk | Convert::CmykJpeg => 4,
+            _ => dir.samples,
         };
         if dir.bits >= 8 && per_pixel < keep {
             return Err(decode_err(format!(
@@ -416,40 +569,116 @@ impl Reader<'_> {
             DecodingResult::F64(v) => {
                 Texels::F32(select(v, pick)?.into_iter().map(|x| x as f32).collect())
             }
+            DecodingResult::U32(v) => Texels::F32(scaled(select(v, pick)?, u32::MAX as f64)),
+            DecodingResult::I8(v) => Texels::F32(scaled(select(v, pick)?, i8::MAX as f64)),
+            DecodingResult::I16(v) => Texels::F32(scaled(select(v, pick)?, i16::MAX as f64)),
+            DecodingResult::I32(v) => Texels::F32(scaled(select(v, pick)?, i32::MAX as f64)),
             _ => {
                 return Err(decode_err(
                     "the decoder returned a sample type parvo does not read",
                 ));
             }
         };
+        let texels = match dir.convert {
+            Convert::None => texels,
+            c => to_rgb(c, texels)?,
+        };
         Texture::from_texels(dir.width, dir.height, dir.format, texels)
     }
+}
+
+/// Integer codes as floats, `v / max` (OpenImageIO's conversion of
+/// signed and 32-bit integers to float: −128 of 8 bits is −1.008).
+fn scaled<T: Into<f64> + Copy>(v: Vec<T>, max: f64) -> Vec<f32> {
+    v.into_iter().map(|x| (x.into() / max) as f32).collect()
+}
+
+/// RGB from CMYK or JPEG's YCbCr samples, as OpenImageIO (with libtiff
+/// and libjpeg) converts them.
+fn to_rgb(convert: Convert, texels: Texels) -> Result<Texels> {
+    // OpenImageIO's arithmetic in f32: a code times 1/max, and back as
+    // x · max + 0.5 truncated.
+    fn cmyk<T: Copy + Into<f64>>(v: &[T], max: f32, from: impl Fn(f32) -> T) -> Vec<T> {
+        let scale = 1.0 / max;
+        v.chunks_exact(4)
+            .flat_map(|p| {
+                let f = |c: T| c.into() as f32 * scale;
+                let k = 1.0 - f(p[3]);
+                let ink = |c: T| (((1.0 - f(c)) * k) * max + 0.5).clamp(0.0, max);
+                [from(ink(p[0])), from(ink(p[1])), from(ink(p[2]))]
+            })
+            .collect()
+    }
+    Ok(match (convert, texels) {
+        (Convert::Cmyk, Texels::U8(v)) => Texels::U8(cmyk(&v, 255.0, |x| x as u8)),
+        (Convert::Cmyk, Texels::U16(v)) => Texels::U16(cmyk(&v, 65535.0, |x| x as u16)),
+        (Convert::CmykJpeg, Texels::U8(v)) => Texels::U8(
+            v.chunks_exact(4)
+                .flat_map(|p| {
+                    let k = 255 - p[3] as u32;
+                    [0, 1, 2].map(|c| (k * (255 - p[c] as u32) / 255) as u8)
+                })
+                .collect(),
+        ),
+        (Convert::YccJpeg, Texels::U8(v)) => {
+            let t = Ycc::jpeg();
+            Texels::U8(
+                v.chunks_exact(3)
+                    .flat_map(|p| t.rgb(p[0], p[1], p[2]))
+                    .collect(),
+            )
+        }
+        _ => {
+            return Err(decode_err(
+                "the decoder returned CMYK or YCbCr samples of another type than the tags declare",
+            ));
+        }
+    })
 }
 
 /// The colour channels a `PhotometricInterpretation` means (1 grey or
 /// palette index, 3 RGB); the interpretations parvo does not read are
 /// refused in words.
-fn colour_channels(photometric: u64, stored_samples: usize, bits: u16) -> Result<usize> {
+fn colour_channels(
+    photometric: u64,
+    stored_samples: usize,
+    bits: u16,
+    compression: u32,
+) -> Result<usize> {
     match photometric {
         1 | 3 => Ok(1),
         2 => Ok(3),
         // The crate inverts one WhiteIsZero channel (as libtiff
-        // and OpenImageIO read it: 0 is white).
-        0 if stored_samples == 1 && matches!(bits, 1 | 2 | 4 | 8 | 16 | 32 | 64) => Ok(1),
+        // and OpenImageIO read it: 0 is white); parvo inverts the others
+        // (see `tiff/raw.rs`).
+        0 if stored_samples == 1 && matches!(bits, 1 | 2 | 4 | 8..=16 | 32 | 64) => Ok(1),
         0 if stored_samples == 1 => Err(decode_err(format!(
-            "WhiteIsZero (inverted grey) TIFF of {}-bit samples is not supported (1, 2, \
-             4, 8 and 16 bits are)",
-            bits
+            "WhiteIsZero (inverted grey) TIFF of {bits}-bit samples is not supported in this \
+             layout: store it as BlackIsZero grey"
         ))),
         0 => Err(decode_err(
             "WhiteIsZero (inverted grey) TIFF with an alpha or extra channel is not \
-             supported",
+             supported: store it as BlackIsZero grey",
         )),
-        4 => Err(decode_err("transparency-mask TIFF is not supported")),
-        5 => Err(decode_err("CMYK TIFF is not supported")),
-        6 => Err(decode_err("YCbCr TIFF is not supported (store it as RGB)")),
-        8..=10 => Err(decode_err("CIE L*a*b* TIFF is not supported")),
-        32844 | 32845 => Err(decode_err("LogLuv (SGI) TIFF is not supported")),
+        4 => Err(decode_err(
+            "transparency-mask TIFF (PhotometricInterpretation 4) is not supported",
+        )),
+        // CMYK's conversion was decided before.
+        5 => Ok(3),
+        6 if compression == 7 => Ok(3),
+        6 => Err(decode_err(format!(
+            "YCbCr TIFF of {stored_samples} samples of {bits} bits{} is not supported (8-bit \
+             YCbCr in strips, interleaved, or in JPEG, is): store it as RGB",
+            if compression == 1 {
+                ""
+            } else {
+                " in this layout"
+            }
+        ))),
+        8..=10 => Err(decode_err(
+            "CIE L*a*b* TIFF is not supported: convert it to RGB",
+        )),
+        32844 | 32845 => Err(decode_err(logluv(photometric))),
         u64::MAX => Err(decode_err(
             "the PhotometricInterpretation tag does not hold one number",
         )),
@@ -457,6 +686,20 @@ fn colour_channels(photometric: u64, stored_samples: usize, bits: u16) -> Result
             "photometric interpretation {p} is not supported"
         ))),
     }
+}
+
+/// The refusal of SGI's log-encoded TIFF (PhotometricInterpretation
+/// 32844 LogL, 32845 LogLuv).
+pub(super) fn logluv(photometric: u64) -> String {
+    format!(
+        "{} (SGI log-encoded high dynamic range) TIFF is not supported: convert it to OpenEXR \
+         or to a float RGB TIFF",
+        if photometric == 32844 {
+            "LogL"
+        } else {
+            "LogLuv"
+        }
+    )
 }
 
 /// The channel type samples of `sample_format` (1 unsigned, 2 signed, 3
@@ -475,20 +718,29 @@ fn channel_type(
         (1, 16) => ChannelType::U16,
         (3, 16) => ChannelType::F16,
         (3, 32) | (3, 64) => ChannelType::F32,
+        // Signed and 32-bit unsigned integers load as f32 scaled as
+        // OpenImageIO converts them to float (v / the type's maximum).
+        (1, 32) | (2, 8 | 16 | 32) => ChannelType::F32,
         (1, b) if b < 8 => {
             return Err(decode_err(format!(
                 "{b}-bit samples are supported for one grey channel, not for {stored_samples} \
                  channels"
             )));
         }
+        (1, b @ (9..=15 | 17..=31)) => {
+            return Err(decode_err(format!(
+                "{b}-bit samples with a predictor, in tiles of planar data or in JPEG are not \
+                 supported (libtiff reads no predictor for them either): store them as 16-bit"
+            )));
+        }
         (1, b) => {
             return Err(decode_err(format!(
-                "{b}-bit unsigned integer samples are not supported (8 and 16 are)"
+                "{b}-bit unsigned integer samples are not supported (1 to 32 bits are)"
             )));
         }
         (2, b) => {
             return Err(decode_err(format!(
-                "signed {b}-bit samples are not supported"
+                "signed {b}-bit samples are not supported (8, 16 and 32 bits are)"
             )));
         }
         (f, b) => {
@@ -719,6 +971,12 @@ pub fn load(path: &Path, limits: &Limits, options: &LoadOptions) -> Result<Loade
     let mipmapped = chain.dirs[0].entry(tag::TEXTURE_FORMAT).is_some();
     let (first, count) = directories_read(pages, mipmapped, options)?;
     for d in &chain.dirs[first..first + count] {
+        if d.unsigned(&l, tag::COMPRESSION) == Some(6) {
+            return Err(decode_err(
+                "old-style JPEG compression (Compression 6, from before TIFF 6.0) is not \
+                 supported: re-save it with JPEG (7), Deflate or LZW compression",
+            ));
+        }
         chain::check_extents(&mut file, &l, d).map_err(decode_err)?;
     }
     let (view, fixes, fix_notes) = chain.repair(open()?).map_err(decode_err)?;

@@ -22,6 +22,8 @@ use std::collections::HashSet;
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom};
 
+use super::raw::View;
+
 /// Tags parvo reads or rewrites before the crate does.
 pub(super) mod tag {
     pub const IMAGE_WIDTH: u16 = 256;
@@ -34,6 +36,7 @@ pub(super) mod tag {
     pub const ROWS_PER_STRIP: u16 = 278;
     pub const STRIP_BYTE_COUNTS: u16 = 279;
     pub const PLANAR_CONFIGURATION: u16 = 284;
+    pub const PREDICTOR: u16 = 317;
     pub const TILE_WIDTH: u16 = 322;
     pub const TILE_LENGTH: u16 = 323;
     pub const TILE_OFFSETS: u16 = 324;
@@ -43,6 +46,7 @@ pub(super) mod tag {
     pub const SAMPLE_FORMAT: u16 = 339;
     pub const JPEG_TABLES: u16 = 347;
     pub const YCBCR_SUBSAMPLING: u16 = 530;
+    pub const REFERENCE_BLACK_WHITE: u16 = 532;
     /// Pixar's `textureformat` (maketx writes it).
     pub const TEXTURE_FORMAT: u16 = 33302;
     /// Pixar's `wrapmodes`.
@@ -195,8 +199,25 @@ impl Entry {
         b
     }
 
+    /// A LONG entry holding one value.
+    pub fn long(l: &Layout, tag: u16, v: u32) -> Entry {
+        let mut field = [0u8; 8];
+        let b = if l.little {
+            v.to_le_bytes()
+        } else {
+            v.to_be_bytes()
+        };
+        field[..4].copy_from_slice(&b);
+        Entry {
+            tag,
+            ty: 4,
+            count: 1,
+            field,
+        }
+    }
+
     /// A SHORT entry holding one value.
-    fn short(l: &Layout, tag: u16, v: u16) -> Entry {
+    pub fn short(l: &Layout, tag: u16, v: u16) -> Entry {
         let mut field = [0u8; 8];
         field[..2].copy_from_slice(&l.put_u16(v));
         Entry {
@@ -233,7 +254,7 @@ impl Dir {
 
 /// What parvo changed in one directory before the crate reads it, and
 /// why: the decoder sees `told` as the photometric interpretation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) struct Fix {
     /// The `PhotometricInterpretation` the file stores (`None`: no tag).
     pub stored_photometric: Option<u64>,
@@ -246,6 +267,9 @@ pub(super) struct Fix {
     /// drops a sample it does not take for alpha, and parvo reads it back
     /// as data.
     pub extra_data: bool,
+    /// The samples are handed to the decoder as rows of bytes, which
+    /// parvo unpacks (see [`View`]).
+    pub view: Option<View>,
 }
 
 /// The directories of a file up to the first repeated one (or the end of
@@ -414,7 +438,7 @@ pub(super) fn check_extents(f: &mut File, l: &Layout, dir: &Dir) -> Result<(), S
         tag::ROWS_PER_STRIP,
         tag::PLANAR_CONFIGURATION,
         266, // FillOrder
-        317, // Predictor
+        tag::PREDICTOR,
         tag::TILE_WIDTH,
         tag::TILE_LENGTH,
         tag::BITS_PER_SAMPLE,
@@ -527,9 +551,25 @@ fn uncompressed_sizes(
     }
 }
 
+/// The values of a RATIONAL entry (`None` for another type or values
+/// that cannot be read).
+pub(super) fn rationals(f: &mut File, l: &Layout, e: &Entry) -> Option<Vec<f64>> {
+    if e.ty != 5 || e.count > 64 {
+        return None;
+    }
+    let (at, n) = e.out_of_line(l)?;
+    let mut raw = vec![0u8; n as usize];
+    read_at(f, at, &mut raw).ok()?;
+    Some(
+        raw.chunks_exact(8)
+            .map(|b| l.u32(b) as f64 / (l.u32(&b[4..]) as f64).max(f64::MIN_POSITIVE))
+            .collect(),
+    )
+}
+
 /// The unsigned values of a SHORT/LONG/LONG8 entry (`None` for another
 /// type or values that cannot be read).
-fn values(f: &mut File, l: &Layout, e: &Entry) -> Option<Vec<u64>> {
+pub(super) fn values(f: &mut File, l: &Layout, e: &Entry) -> Option<Vec<u64>> {
     let size = match e.ty {
         3 => 2,
         4 | 13 => 4,
@@ -597,22 +637,23 @@ impl Chain {
     /// Decide what each directory needs (see [`Fix`]) and build the view
     /// of the file the decoder reads: directories rewritten after the
     /// end, pointers redirected, a loop cut. Notes say what was assumed.
-    pub fn repair(&self, file: File) -> Result<(Patched, Vec<Fix>, Vec<String>), String> {
+    pub fn repair(&self, mut file: File) -> Result<(Patched, Vec<Fix>, Vec<String>), String> {
         let l = &self.layout;
+        let mut notes = Vec::new();
+        let fixes: Vec<Fix> = (self.dirs.iter().enumerate())
+            .map(|(k, d)| self.fix(&mut file, k, d, &mut notes))
+            .collect();
         // The rewritten directories start a little after the end of the
         // file: a strip that runs past the end reads nothing there (the
         // gap reads as the end of the file), never a rewritten directory.
         let tail_base = l.len.div_ceil(16) * 16 + 16;
         let mut view = Patched::new(file, l.len, tail_base);
-        let mut fixes = Vec::with_capacity(self.dirs.len());
-        let mut notes = Vec::new();
         let mut pointer_at = self.first_at;
-        for (k, d) in self.dirs.iter().enumerate() {
-            let fix = self.fix(k, d, &mut notes);
+        for (k, (d, &fix)) in self.dirs.iter().zip(&fixes).enumerate() {
             let rewrite = Rewrite::of(l, d);
-            fixes.push(fix);
             let last = k + 1 == self.dirs.len();
-            let next_at = if fix.told.is_some() || rewrite.needed() || fix.extra_data {
+            let changed = fix.told.is_some() || fix.extra_data || fix.view.is_some();
+            let next_at = if changed || rewrite.needed() {
                 let next = if last && self.cut { 0 } else { d.next };
                 let new = rewritten(l, d, fix, rewrite, next);
                 let at = view.append_dir(l, &new)?;
@@ -631,7 +672,7 @@ impl Chain {
 
     /// What directory `k` needs told to the decoder (see [`Fix`]); a
     /// missing `PhotometricInterpretation` gets a note in `notes`.
-    fn fix(&self, k: usize, d: &Dir, notes: &mut Vec<String>) -> Fix {
+    fn fix(&self, f: &mut File, k: usize, d: &Dir, notes: &mut Vec<String>) -> Fix {
         let l = &self.layout;
         let stored = d.entry(tag::PHOTOMETRIC).map(|e| e.inline_unsigned(l));
         let stored_photometric = match stored {
@@ -674,10 +715,12 @@ impl Chain {
             && samples == 4
             && d.entry(tag::EXTRA_SAMPLES)
                 .is_some_and(|e| e.count == 1 && e.inline_unsigned(l) == Some(0));
+        let view = View::of(f, l, d, stored_photometric.or(told.map(u64::from)));
         Fix {
             stored_photometric,
             told,
             extra_data,
+            view,
         }
     }
 }
@@ -761,6 +804,9 @@ fn rewritten(l: &Layout, d: &Dir, fix: Fix, rewrite: Rewrite, next: u64) -> Dir 
                 t => t,
             };
         }
+    }
+    if let Some(v) = fix.view {
+        entries = v.entries(l, entries);
     }
     entries.sort_by_key(|e| e.tag);
     Dir {

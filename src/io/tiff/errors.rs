@@ -187,8 +187,7 @@ fn unsupported(u: TiffUnsupportedError, raw: Option<&chain::Dir>, l: &chain::Lay
             b.first().copied().unwrap_or(0)
         ),
         U::UnknownInterpretation => match raw.and_then(|r| r.unsigned(l, tag::PHOTOMETRIC)) {
-            Some(32844) => "LogL (SGI) TIFF is not supported".into(),
-            Some(32845) => "LogLuv (SGI) TIFF is not supported".into(),
+            Some(p @ (32844 | 32845)) => super::logluv(p),
             Some(p) => format!("photometric interpretation {p} is not supported"),
             None => "its PhotometricInterpretation tag does not hold one number".into(),
         },

@@ -42,15 +42,19 @@ fn one_and_two_channel_float_tiffs_load() {
     assert_eq!(l.base().to_linear(), [0.5, 1.0, 2.0, 0.25]);
 }
 
+/// CMYK was refused here; it reads as RGB since issue 53 (see
+/// tiff_valid_kinds_refused.rs), R = (1 − C)(1 − K).
 #[test]
-fn unsupported_tiffs_say_what_in_words() {
+fn cmyk_tiffs_read_as_rgb() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("cmyk.tif");
     let mut e = tiff::encoder::TiffEncoder::new(std::fs::File::create(&p).unwrap()).unwrap();
     e.write_image::<tiff::encoder::colortype::CMYK8>(1, 1, &[1, 2, 3, 4])
         .unwrap();
-    let err = parvo::io::load(s(&p), &parvo::io::Limits::default())
-        .unwrap_err()
-        .to_string();
-    assert!(err.contains("CMYK TIFF is not supported"), "{err}");
+    let l = parvo::io::load(s(&p), &parvo::io::Limits::default()).unwrap();
+    let want: Vec<u8> = [1.0f64, 2.0, 3.0]
+        .iter()
+        .map(|c| ((1.0 - c / 255.0) * (1.0 - 4.0 / 255.0) * 255.0).round() as u8)
+        .collect();
+    assert_eq!(l.base().texels(), &parvo::Texels::U8(want));
 }

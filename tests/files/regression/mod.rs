@@ -49,4 +49,5 @@ mod texture_store_sat_kept_first_callers_wrap;
 mod tiff_associated_alpha_premultiplied_twice;
 mod tiff_rgb_data_sample_dropped;
 mod tiff_untagged_and_looping_refused;
+mod tiff_valid_kinds_refused;
 mod util;
