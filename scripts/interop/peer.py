@@ -14,7 +14,9 @@ file's repository, path, commit and licence) goes through `parvo info` and
   are compared as stored codes through parvo's PNG levels (`out: png`:
   straight alpha, the file's transfer kept), float inputs and
   associated-alpha TIFFs through its f32 EXR (`out: exr`: linear,
-  premultiplied); `tol` is the largest difference allowed in those units
+  premultiplied; a KTX2 integer format's golden EXR, which holds the
+  numbers, is turned into the codes parvo keeps: `ref_transform`
+  uint_codes / sint_codes); `tol` is the largest difference allowed in those units
   (0..1 for codes) and `why` in the manifest says where it comes from.
 - `refuse`: both commands exit with status 1 and one message in plain words
   that matches `refuse` (a regular expression naming the format or
@@ -179,11 +181,28 @@ def reference(entry):
             a = np.concatenate([f[:, :, :-1] * f[:, :, -1:], f[:, :, -1:]], axis=2).astype(np.float64)
     if a is not None and entry.get("ref_transform") == "invert":
         a = 1.0 - a
+    if a is not None and entry.get("ref_transform") in ("uint_codes", "sint_codes"):
+        a = integer_codes(a, entry["ref_transform"], int(entry["ref_bits"]))
     if a is not None and entry.get("ref_transform") == "snorm8_biased":
         # Pillow stores signed (SNORM) BC4/BC5 codes c in -127..127 as
         # c + 128; the value they stand for is max(c / 127, -1).
         a = np.maximum((np.rint(a * 255) - 128) / 127, -1.0)
     return a, err
+
+
+def integer_codes(a, transform, bits):
+    """`ktx extract`'s EXR of an integer format holds the numbers as floats;
+    parvo keeps them as `bits`-bit codes n / (2^bits - 1), a signed format's
+    offset by 2^(bits-1) (two's complement with the sign bit flipped).
+    KTX-Software's convertSIntToFloat reads sign and magnitude (a stored
+    0xFF is -127, not -1), so a negative reading -m is the stored code
+    2^(bits-1) | m; a stored 2^(bits-1) reads as 0, like 0, so the
+    manifest's signed files are ones without that code."""
+    half = 2 ** (bits - 1)
+    n = np.rint(a).astype(np.int64)
+    if transform == "sint_codes":
+        n = np.where(n < 0, half | -n, n) ^ half
+    return n.astype(np.float64) / (2.0 ** bits - 1)
 
 
 def reference_values(entry, ref, f):

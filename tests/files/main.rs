@@ -31,6 +31,7 @@ mod io_dds_read;
 mod io_exr_read;
 mod io_image_inputs;
 mod io_ktx2_fields;
+mod io_ktx2_packed;
 mod mip_flags_by_kind;
 mod mip_separable_fast;
 mod mip_streamed;

@@ -39,8 +39,16 @@
 //! applied. A `KTXorientation` other than `rd` (rows stored bottom to
 //! top for `u`, columns right to left for `l`) is applied to every level
 //! on load, with a note, so the levels come out in the order parvo writes
-//! (`rd`). Formats parvo does not read are named by their Vulkan names,
-//! and Basis Universal files (BasisLZ/ETC1S, UASTC) as such.
+//! (`rd`). The uncompressed formats parvo has no texel type for are
+//! unpacked into the nearest one as libktx's `ktx extract` presents them
+//! (the `packed` module): `B8G8R8A8`-style orders put in R, G, B, A order;
+//! packed UNORM fields (`R5G6B5`, `A1R5G5B5`, `R4G4B4A4`, ..., the 10- and
+//! 12-bit `A2R10G10B10`, `R10X6…`, `R12X4…`) widened to u8 or u16 by bit
+//! replication; `A8_UNORM` as grey 0 + alpha; 8/16-bit `_UINT` as codes,
+//! `_SINT` as codes offset by half the range, `_SNORM` as f32. Formats
+//! parvo does not read are named by their Vulkan names with the format to
+//! convert them to, and Basis Universal files (BasisLZ/ETC1S, UASTC) as
+//! such.
 
 use std::path::Path;
 
@@ -52,8 +60,11 @@ use crate::texture::ImageKind;
 use crate::texture::Texture;
 use std::io::Write;
 
+mod packed;
 mod read;
 mod write;
+
+use packed::{Packed, packed_of_vk};
 
 pub use read::*;
 pub use write::*;
@@ -138,9 +149,22 @@ pub fn vk_format_name(vk: u32) -> Option<String> {
         .then(|| format!("VK_FORMAT_{f:?}"))
 }
 
+/// The Vulkan name of a `_USCALED` or `_SSCALED` format (the UNORM
+/// format's value plus 2 or 3), which KTX 2.0 prohibits and the `ktx2`
+/// crate does not list, for messages about files that use one anyway.
+fn scaled_name(vk: u32) -> Option<String> {
+    const UNORM: [u32; 13] = [9, 16, 23, 30, 37, 44, 51, 58, 64, 70, 77, 84, 91];
+    let (base, scaled) = UNORM.iter().find_map(|&b| match vk.checked_sub(b) {
+        Some(2) => Some((b, "_USCALED")),
+        Some(3) => Some((b, "_SSCALED")),
+        _ => None,
+    })?;
+    Some(vk_format_name(base)?.replace("_UNORM", scaled))
+}
+
 /// `VK_FORMAT_… (n)`, or `vkFormat n` when the value has no name.
 fn vk_describe(vk: u32) -> String {
-    match vk_format_name(vk) {
+    match vk_format_name(vk).or_else(|| scaled_name(vk)) {
         Some(name) => format!("{name} ({vk})"),
         None => format!("vkFormat {vk}"),
     }
@@ -199,13 +223,38 @@ fn unsupported_format(vk: u32, scheme: u32, model: Option<u32>) -> Error {
                 None => format!(" (colour model {m})"),
             })
         ),
-        _ => format!(
-            "{} is not a format parvo reads (it reads the uncompressed R, RG, RGB and RGBA \
-             UNORM/SRGB 8-bit, UNORM 16-bit and SFLOAT 16/32-bit formats, and BC1-BC7)",
-            vk_describe(vk)
-        ),
+        _ => format!("{} {}", vk_describe(vk), convert_to(vk)),
     };
     decode_err(reason)
+}
+
+/// What a vkFormat parvo does not read is, and what to convert it to,
+/// after its name.
+fn convert_to(vk: u32) -> &'static str {
+    match vk {
+        127 => "is a stencil format, which parvo does not read; store it as R8_UINT first",
+        124..=130 => {
+            "is a depth/stencil format, which parvo does not read; store the depth as \
+             R16_UNORM or R32_SFLOAT first"
+        }
+        147..=184 | 1000054000..=1000054007 | 1000066000..=1000066013 | 1000288000..=1000288029 => {
+            "is a block-compressed format parvo does not decode (it decodes BC1-BC7); convert it \
+             to R8G8B8A8 or a BC format first (for example with KTX-Software's `ktx extract` to \
+             PNG or EXR)"
+        }
+        1000156000..=1000156033 | 1000330000..=1000330003 => {
+            "is a YCbCr (4:2:2 or multi-planar) format, which parvo does not read; convert it to \
+             R8G8B8A8_UNORM or R16G16B16A16_UNORM first"
+        }
+        122 | 123 => {
+            "is a packed float format parvo does not read; convert it to R16G16B16A16_SFLOAT \
+             first"
+        }
+        _ => {
+            "is not a format parvo reads; convert it to R8G8B8A8_UNORM (or _SRGB), \
+             R16G16B16A16_UNORM or R32G32B32A32_SFLOAT first"
+        }
+    }
 }
 
 /// The closest format KTX2 can store `f` in: same values where Vulkan has

@@ -1,6 +1,7 @@
-//! Reading KTX2: every vkFormat parvo has a texel format for and the BC
-//! formats, supercompressed or not, the DFD's alpha and colour, orientation
-//! and swizzle applied.
+//! Reading KTX2: every vkFormat parvo has a texel format for, the formats
+//! unpacked into one (the `packed` module) and the BC formats,
+//! supercompressed or not, the DFD's alpha and colour, orientation and
+//! swizzle applied.
 
 use super::*;
 
@@ -193,9 +194,17 @@ pub(super) fn load_bytes(
     let scheme = u32::from_le_bytes(bytes[44..48].try_into().map_err(decode_err)?);
     let vk = h.format.map(|f| f.value()).unwrap_or(0);
     let block = block_format_of_vk(vk);
-    let mut format = match block {
-        Some((bf, srgb, _)) => bf.decoded_format(srgb),
-        None => format_of_vk(vk).ok_or_else(|| {
+    let packed = match (block, format_of_vk(vk)) {
+        (None, None) => packed_of_vk(vk),
+        _ => None,
+    };
+    let mut format = match (block, packed) {
+        (Some((bf, srgb, _)), _) => bf.decoded_format(srgb),
+        (None, Some(p)) => {
+            notes.extend(p.note(&vk_format_name(vk).unwrap_or_default()));
+            p.format
+        }
+        (None, None) => format_of_vk(vk).ok_or_else(|| {
             unsupported_format(vk, scheme, dfd_model_word(bytes).map(|w| w & 0xff))
         })?,
     };
@@ -209,6 +218,7 @@ pub(super) fn load_bytes(
         height: h.pixel_height.max(1),
         scheme,
         block,
+        packed,
         format,
         premultiplied,
         images: kind.images(),
@@ -284,6 +294,10 @@ pub(super) struct StoredLevels {
     /// The block format, sRGB, and whether it has alpha; `None` for plain
     /// texels of `format`.
     block: Option<(BlockFormat, bool, bool)>,
+    /// The stored layout of a format unpacked on load (`B8G8R8A8`,
+    /// `R5G6B5`, `R8G8B8A8_UINT`, ...); `None` for blocks and for texels
+    /// stored as `format`.
+    packed: Option<Packed>,
     /// The texel format the levels decode to.
     format: Format,
     /// The DFD says alpha is premultiplied.
@@ -306,10 +320,12 @@ impl StoredLevels {
 
     /// Bytes of one `w × h` image as stored (before supercompression).
     fn image_len(&self, (w, h): (u32, u32)) -> u64 {
-        match self.block {
-            Some((bf, ..)) => bf.level_bytes(w, h),
-            None => w as u64 * h as u64 * self.format.texel_bytes() as u64,
-        }
+        let texel = match (self.block, self.packed) {
+            (Some((bf, ..)), _) => return bf.level_bytes(w, h),
+            (None, Some(p)) => p.bytes as u64,
+            (None, None) => self.format.texel_bytes() as u64,
+        };
+        w as u64 * h as u64 * texel
     }
 
     /// Bytes of a `w × h` level as stored (every face and layer, before
@@ -382,7 +398,8 @@ impl StoredLevels {
     }
 
     /// One `w × h` level from its stored bytes (inflated, of the right
-    /// length): BC blocks decoded, plain texels read little-endian.
+    /// length): BC blocks decoded, packed texels unpacked, plain texels
+    /// read little-endian.
     fn decode(&self, data: &[u8], (w, h): (u32, u32)) -> Result<Texture> {
         match self.block {
             Some((bf, srgb, has_alpha)) => {
@@ -397,7 +414,10 @@ impl StoredLevels {
                 crate::compress::decode(bf, srgb, alpha, w, h, data)
             }
             None => {
-                let texels = crate::io::texels_from_le(self.format.channel_type, data);
+                let texels = match self.packed {
+                    Some(p) => p.unpack(data),
+                    None => crate::io::texels_from_le(self.format.channel_type, data),
+                };
                 Texture::from_texels(w, h, self.format, texels)
             }
         }
@@ -434,7 +454,8 @@ pub(super) fn image_kind(h: &::ktx2::Header) -> Result<ImageKind> {
     if h.pixel_depth > 1 {
         return Err(decode_err(format!(
             "volume textures are not supported (this one is {} texels deep; parvo reads 2-D \
-             textures, arrays and cube maps)",
+             textures, arrays and cube maps): store its depth slices as the layers of a 2-D \
+             array texture first",
             h.pixel_depth
         )));
     }
