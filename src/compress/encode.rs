@@ -57,12 +57,50 @@ fn encode_err(reason: impl Into<String>) -> Error {
     }
 }
 
+/// Where an encoding pass writes its blocks, and whom it tells of the
+/// texels done (see [`encode_with`]).
+struct Blocks<'a> {
+    out: &'a mut [u8],
+    tick: &'a (dyn Fn(u64) + Sync),
+}
+
+/// The passes over a level [`encode_with`] makes: the fit, and the
+/// refits that follow it at normal and slow quality (BC4/BC5's single-
+/// channel refit, BC1/BC3's colour refit; BC1 with alpha is one pass).
+fn passes(format: BlockFormat, quality: Quality, level: &Texture) -> u64 {
+    let refits = match level.texels() {
+        Texels::U8(_) if !(format == BlockFormat::Bc1 && level.format().has_alpha()) => {
+            let single = format.holds_data() && quality != Quality::Fast;
+            let colour =
+                matches!(format, BlockFormat::Bc1 | BlockFormat::Bc3) && quality != Quality::Fast;
+            single as u64 + colour as u64
+        }
+        _ => 0,
+    };
+    1 + refits
+}
+
 /// Block rows per parallel band of the ISPC encoders.
 const BAND_BLOCK_ROWS: usize = 16;
 
 /// Encode one level (in [`input_format`]) as `format` blocks, row-major,
 /// [`BlockFormat::level_bytes`] long.
 pub fn encode(format: BlockFormat, quality: Quality, level: &Texture) -> Result<Vec<u8>> {
+    encode_with(format, quality, level, &|_| {})
+}
+
+/// [`encode`], calling `tick(n)` as the work of `n` more of the level's
+/// texels is done (block row by block row; each pass of the encoder, the
+/// fit and the refits, counts for its share), so a progress bar advances
+/// with the work.
+pub fn encode_with(
+    format: BlockFormat,
+    quality: Quality,
+    level: &Texture,
+    tick: &(dyn Fn(u64) + Sync),
+) -> Result<Vec<u8>> {
+    let passes = passes(format, quality, level);
+    let tick = |n: u64| tick(n / passes);
     if !can_encode(format) {
         return Err(encode_err(format!("parvo does not encode {format}")));
     }
@@ -79,24 +117,16 @@ pub fn encode(format: BlockFormat, quality: Quality, level: &Texture) -> Result<
     let mut out = vec![0u8; out_len];
     match (format, level.texels()) {
         (BlockFormat::Bc1, Texels::U8(v)) if f.has_alpha() => {
-            let fmt = texpresso::Format::Bc1;
-            let params = texpresso::Params {
-                algorithm: match quality {
-                    Quality::Fast => texpresso::Algorithm::RangeFit,
-                    Quality::Normal => texpresso::Algorithm::ClusterFit,
-                    Quality::Slow => texpresso::Algorithm::IterativeClusterFit,
-                },
-                weights: texpresso::COLOUR_WEIGHTS_UNIFORM,
-                weigh_colour_by_alpha: f.alpha == AlphaMode::Straight,
-            };
-            if fmt.compressed_size(w, h) != out_len {
-                return Err(encode_err("block count mismatch"));
-            }
-            fmt.compress(v, w, h, params, &mut out);
+            bc1_with_alpha(v, w, h, quality, f.alpha == AlphaMode::Straight, &mut out)?;
+            tick((w * h) as u64);
         }
         (_, Texels::U8(v)) => {
             let ch = f.channels as usize;
-            ispc_bands(v, w, h, ch, format, &mut out, |band, bw, bh, dst| {
+            let blocks = Blocks {
+                out: &mut out,
+                tick: &tick,
+            };
+            ispc_bands(v, w, h, ch, format, blocks, |band, bw, bh, dst| {
                 let stride = (bw * ch) as u32;
                 let (width, height) = (bw as u32, bh as u32);
                 let rgba = intel_tex_2::RgbaSurface {
@@ -140,7 +170,11 @@ pub fn encode(format: BlockFormat, quality: Quality, level: &Texture) -> Result<
                 }
             });
             if format.holds_data() && quality != Quality::Fast {
-                refine_single(v, w, h, ch, format, quality, &mut out);
+                let blocks = Blocks {
+                    out: &mut out,
+                    tick: &tick,
+                };
+                refine_single(v, w, h, ch, format, quality, blocks);
             }
             if matches!(format, BlockFormat::Bc1 | BlockFormat::Bc3) && quality != Quality::Fast {
                 refine_colour(
@@ -150,16 +184,50 @@ pub fn encode(format: BlockFormat, quality: Quality, level: &Texture) -> Result<
                     format,
                     quality,
                     f.alpha == AlphaMode::Straight,
-                    &mut out,
+                    Blocks {
+                        out: &mut out,
+                        tick: &tick,
+                    },
                 );
             }
         }
         (BlockFormat::Bc6h { .. }, Texels::F16(v)) => {
-            encode_bc6h(v, w, h, format, quality, &mut out)
+            let blocks = Blocks {
+                out: &mut out,
+                tick: &tick,
+            };
+            encode_bc6h(v, w, h, format, quality, blocks)
         }
         _ => return Err(encode_err(format!("{format} cannot encode {f} texels"))),
     }
     Ok(out)
+}
+
+/// BC1 blocks (with their 1-bit alpha) of an RGBA u8 level into `out`,
+/// by texpresso (ISPC's BC1 kernel has no alpha).
+fn bc1_with_alpha(
+    v: &[u8],
+    w: usize,
+    h: usize,
+    quality: Quality,
+    by_alpha: bool,
+    out: &mut [u8],
+) -> Result<()> {
+    let fmt = texpresso::Format::Bc1;
+    let params = texpresso::Params {
+        algorithm: match quality {
+            Quality::Fast => texpresso::Algorithm::RangeFit,
+            Quality::Normal => texpresso::Algorithm::ClusterFit,
+            Quality::Slow => texpresso::Algorithm::IterativeClusterFit,
+        },
+        weights: texpresso::COLOUR_WEIGHTS_UNIFORM,
+        weigh_colour_by_alpha: by_alpha,
+    };
+    if fmt.compressed_size(w, h) != out.len() {
+        return Err(encode_err("block count mismatch"));
+    }
+    fmt.compress(v, w, h, params, out);
+    Ok(())
 }
 
 /// BC6H (unsigned half) blocks of an RGB f16 level into `out`.
@@ -169,7 +237,7 @@ fn encode_bc6h(
     h: usize,
     format: BlockFormat,
     quality: Quality,
-    out: &mut [u8],
+    blocks: Blocks<'_>,
 ) {
     // ISPC reads RGBA halves; unsigned half has no negatives, and
     // NaN or infinity have no block encoding: clamp to [0, MAX].
@@ -192,7 +260,7 @@ fn encode_bc6h(
         Quality::Normal => intel_tex_2::bc6h::basic_settings(),
         Quality::Slow => intel_tex_2::bc6h::slow_settings(),
     };
-    ispc_bands(&rgba, w, h, 8, format, out, |band, bw, bh, dst| {
+    ispc_bands(&rgba, w, h, 8, format, blocks, |band, bw, bh, dst| {
         intel_tex_2::bc6h::compress_blocks_into(
             &s,
             &intel_tex_2::RgbaSurface {
@@ -216,9 +284,10 @@ fn ispc_bands(
     h: usize,
     bpp: usize,
     format: BlockFormat,
-    out: &mut [u8],
+    blocks: Blocks<'_>,
     kernel: impl Fn(&[u8], usize, usize, &mut [u8]) + Sync,
 ) {
+    let Blocks { out, tick } = blocks;
     let bw = w.div_ceil(4);
     let pw = bw * 4;
     let band_bytes = bw * format.block_bytes() * BAND_BLOCK_ROWS;
@@ -239,6 +308,7 @@ fn ispc_bands(
                 }
             }
             kernel(&buf, pw, rows, dst);
+            tick((rows.min(h.saturating_sub(y0)) * w) as u64);
         });
 }
 
@@ -277,14 +347,17 @@ fn refine_single(
     ch: usize,
     format: BlockFormat,
     quality: Quality,
-    out: &mut [u8],
+    blocks: Blocks<'_>,
 ) {
+    let Blocks { out, tick } = blocks;
     let radius = if quality == Quality::Slow { 4 } else { 1 };
     let bb = format.block_bytes();
     let bw = w.div_ceil(4);
     out.par_chunks_mut(bw * bb)
         .enumerate()
         .for_each(|(by, row)| {
+            // This block row's texels, counted as it starts.
+            tick((4.min(h - by * 4) * w) as u64);
             for (bx, blk) in row.chunks_exact_mut(bb).enumerate() {
                 for c in 0..bb / 8 {
                     let mut values = [0u8; 16];
@@ -310,8 +383,9 @@ fn refine_colour(
     format: BlockFormat,
     quality: Quality,
     by_alpha: bool,
-    out: &mut [u8],
+    blocks: Blocks<'_>,
 ) {
+    let Blocks { out, tick } = blocks;
     let effort = colour_effort(quality);
     let bb = format.block_bytes();
     let off = if format == BlockFormat::Bc3 { 8 } else { 0 };
@@ -326,6 +400,8 @@ fn refine_colour(
     out.par_chunks_mut(bw * bb)
         .enumerate()
         .for_each(|(by, row)| {
+            // This block row's texels, counted as it starts.
+            tick((4.min(h - by * 4) * w) as u64);
             for (bx, blk) in row.chunks_exact_mut(bb).enumerate() {
                 let mut px = colour::BlockTexels::default();
                 let mut rgba = [[0u8; 4]; 16];
@@ -373,4 +449,61 @@ fn refine_colour(
                 blk[off..off + 8].copy_from_slice(&c);
             }
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texel::{ChannelType, ColorSpace, Format};
+    use std::sync::Mutex;
+
+    /// The progress an encode reports comes block row by block row, in
+    /// every pass (the ISPC fit and the refits), and adds up to the
+    /// level's texels without passing them.
+    #[test]
+    fn progress_comes_row_by_row_and_adds_up_to_the_level() {
+        let (w, h) = (300u32, 260u32);
+        let mut s = 0x9e37_79b9u32;
+        let noise: Vec<u8> = (0..w * h * 4)
+            .map(|_| {
+                s ^= s << 13;
+                s ^= s >> 17;
+                s ^= s << 5;
+                s as u8
+            })
+            .collect();
+        let level = Texture::from_u8(
+            w,
+            h,
+            Format::new(4, ChannelType::U8, ColorSpace::Srgb),
+            noise,
+        )
+        .unwrap();
+        for (format, quality, passes) in [
+            (BlockFormat::Bc7, Quality::Fast, 1u64),
+            (BlockFormat::Bc3, Quality::Normal, 2),
+        ] {
+            let level = crate::compress::prepare(
+                &level,
+                format,
+                input_format(format, ColorSpace::Srgb, None),
+            )
+            .unwrap();
+            let ticks = Mutex::new(Vec::new());
+            let tick = |n: u64| ticks.lock().unwrap().push(n);
+            let with = encode_with(format, quality, &level, &tick).unwrap();
+            assert_eq!(with, encode(format, quality, &level).unwrap());
+            let ticks = ticks.into_inner().unwrap();
+            let total: u64 = ticks.iter().sum();
+            let texels = (w * h) as u64;
+            // ISPC bands of 16 block rows (5 bands), then one call per
+            // block row (65) in each refit.
+            let calls = 5 + 65 * (passes - 1);
+            assert_eq!(ticks.len() as u64, calls, "{format}");
+            assert!(
+                total <= texels && total + calls >= texels,
+                "{format}: {total} of {texels}"
+            );
+        }
+    }
 }

@@ -150,9 +150,18 @@ pub(crate) fn encode_chain(
                     .map(|l| -> Result<(Vec<u8>, BlockLevel)> {
                         let t = Instant::now();
                         let input = crate::compress::prepare(l, bf, want)?;
-                        let data = crate::compress::encode::encode(bf, quality, &input)?;
+                        // Block row by block row (a 4096² level is most
+                        // of a chain's work).
+                        let ticked = AtomicU64::new(0);
+                        let tick = |n: u64| {
+                            ticked.fetch_add(n, Ordering::Relaxed);
+                            done.fetch_add(n, Ordering::Relaxed);
+                        };
+                        let data =
+                            crate::compress::encode::encode_with(bf, quality, &input, &tick)?;
                         let encode_s = t.elapsed().as_secs_f64();
-                        done.fetch_add(l.texel_count() as u64, Ordering::Relaxed);
+                        let rest = (l.texel_count() as u64).saturating_sub(ticked.into_inner());
+                        done.fetch_add(rest, Ordering::Relaxed);
                         Ok((
                             data,
                             BlockLevel {
