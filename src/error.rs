@@ -75,7 +75,7 @@ pub enum Error {
     #[error("invalid option: {0}")]
     Usage(Box<dyn std::error::Error + Send + Sync>),
     /// A file or directory could not be opened, read or written.
-    #[error("{action}: {error}")]
+    #[error("{action}: {}", io_words(error))]
     Io {
         /// The file or directory involved.
         path: std::path::PathBuf,
@@ -123,5 +123,15 @@ impl Error {
             value: value.to_string(),
             reason: reason.to_string(),
         }
+    }
+}
+
+/// An operating-system error in words: its message without Rust's
+/// "(os error N)" code ("No such file or directory").
+pub(crate) fn io_words(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    match text.rfind(" (os error ") {
+        Some(i) if text.ends_with(')') => text[..i].to_string(),
+        _ => text,
     }
 }

@@ -425,6 +425,8 @@ struct Input {
     channel_names: Vec<String>,
     notes: Vec<Note>,
     read_s: f64,
+    /// The source is a 1-D texture (see [`io::SourceInfo::one_d`]).
+    one_d: bool,
 }
 
 /// The plan of one job: its input read and interpreted, nothing built or
@@ -448,7 +450,7 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     if images::holds_images(&loaded, s) {
         return images::process(job, s, Some(loaded), t_read, progress);
     }
-    let input = read(loaded, s, t_read)?;
+    let input = read(loaded, s, job.kind, t_read)?;
     let out_format = output_format_of(job, s, input.src)?;
     let plan = Plan::new(
         job,
@@ -479,7 +481,9 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
         read_s: input.read_s,
         build_s: 0.0,
         write_s: 0.0,
-        notes: input.notes.clone(),
+        notes: (input.notes.iter().cloned())
+            .chain(codes_decoded_note(input.src, out_format))
+            .collect(),
         blocks: None,
         block_format: s.compress.map(|(bf, _)| block_label(bf, out_format)),
         image_kind: ImageKind::Plain,
@@ -505,7 +509,8 @@ pub fn process(job: &Job, s: &Settings, progress: &mut dyn FnMut(Stage)) -> Resu
     let names = (input.src_kind == FileFormat::Exr
         && input.channel_names.len() == out_format.channels as usize)
         .then(|| input.channel_names.clone());
-    let save = save_options(s, &plan, input.src, fingerprint, names);
+    let mut save = save_options(s, &plan, input.src, fingerprint, names);
+    save.one_d = input.one_d && input.base.height() == 1;
     let mut done = outcome(Status::Written, &input);
     build_and_write(job, s, &plan, input, prepared, &save, &mut done, progress)?;
     Ok(done)
@@ -541,6 +546,7 @@ fn save_options(
         ktx2: s.ktx2,
         attributes,
         placement: crate::env::Placement::Centred,
+        one_d: false,
     }
 }
 
@@ -563,12 +569,12 @@ fn load(job: &Job, s: &Settings) -> Result<(io::Loaded, Option<Vec<Texels>>)> {
 /// The format the build reads a source of format `f` as: its colour space
 /// and alpha as the settings say (a normal map is linear, its fourth
 /// channel data).
-fn read_as(f: Format, s: &Settings) -> Format {
+fn read_as(f: Format, s: &Settings, data: bool) -> Format {
     let mut src = f;
     src.color_space = match (s.color, s.normal_map) {
         (ColorChoice::Linear, _) | (ColorChoice::Auto, true) => ColorSpace::Linear,
         // An output that holds data keeps the stored codes.
-        (ColorChoice::Auto, false) if holds_data(s) => ColorSpace::Linear,
+        (ColorChoice::Auto, false) if data => ColorSpace::Linear,
         (ColorChoice::Srgb, _) => ColorSpace::Srgb,
         // The loader's reading of the file (see io::load).
         (ColorChoice::Auto, false) => src.color_space,
@@ -586,30 +592,52 @@ fn read_as(f: Format, s: &Settings) -> Format {
 
 /// The loader's notes, and the colour assumption said once per file
 /// (a 16-bit grey height map read as sRGB changes every value of a
-/// linear output).
-fn load_notes(loaded: &io::Loaded, s: &Settings) -> Vec<Note> {
+/// linear output); and whether the output holds data, read as the
+/// stored codes (see [`data_output`]).
+fn load_notes(loaded: &io::Loaded, s: &Settings, kind: OutputKind) -> (Vec<Note>, bool) {
     let mut notes: Vec<Note> = loaded.info.notes.iter().cloned().map(Note::Text).collect();
     let f = loaded.base().format();
-    match s.compress {
-        _ if s.color != ColorChoice::Auto || s.normal_map => {}
-        Some((bf, _)) if bf.holds_data() => {
+    if s.color != ColorChoice::Auto || s.normal_map {
+        return (notes, false);
+    }
+    let data = data_output(s, &f, loaded.info.color_stated, kind);
+    match &data {
+        Some(why) => {
             if f.color_space == ColorSpace::Srgb && !f.channel_type.is_float() {
                 notes.push(Note::Text(format!(
-                    "{bf} holds data: the file's stored codes are kept as they are, not \
-                     decoded from sRGB ({} srgb decodes them to linear first)",
+                    "{why}: the file's stored codes are kept as they are, not decoded from sRGB \
+                     ({} srgb decodes them to linear first)",
                     crate::setting::Setting::Color
                 )));
             }
         }
-        _ => notes.extend(io::assumed_color_note(&loaded.info, &f).map(Note::Text)),
+        None => notes.extend(io::assumed_color_note(&loaded.info, &f).map(Note::Text)),
     }
-    notes
+    (notes, data.is_some())
 }
 
-/// True when the output holds data rather than colour (BC4, BC5): the
-/// input's codes are read as they are stored.
-fn holds_data(s: &Settings) -> bool {
-    s.compress.is_some_and(|(bf, _)| bf.holds_data())
+/// Why the output holds data rather than colour, when it does and
+/// neither `--color` nor `--normal-map` says otherwise: BC4 and BC5 (no
+/// sRGB forms; roughness, height, masks, normals), or, for a file that
+/// does not say how its values encode colour (`stated` false), an output
+/// of one channel, or two without alpha (R, G), as `kind` stores it. Such
+/// an output keeps the input's stored codes, as every peer does.
+fn data_output(s: &Settings, f: &Format, stated: bool, kind: OutputKind) -> Option<String> {
+    if s.color != ColorChoice::Auto || s.normal_map {
+        return None;
+    }
+    match s.compress {
+        Some((bf, _)) if bf.holds_data() => return Some(format!("{bf} holds data")),
+        Some(_) => return None,
+        None if stated || f.channel_type.is_float() => return None,
+        None => {}
+    }
+    let kept = output_format(*f, kind, s).is_ok_and(|o| o.channels == f.channels);
+    match f.channels {
+        1 if kept => Some("a one-channel output holds data".into()),
+        2 if kept && !f.has_alpha() => Some("a two-channel output (R, G) holds data".into()),
+        _ => None,
+    }
 }
 
 /// `base` resized as [`Settings::resize_to`] asks (with the wrap modes
@@ -640,13 +668,14 @@ fn resize(base: Texture, s: &Settings, wrap: Wrap) -> Result<(Texture, Option<No
 }
 
 /// `loaded`, one 2-D image, interpreted under `s` and resized.
-fn read(loaded: io::Loaded, s: &Settings, t_read: Instant) -> Result<Input> {
+fn read(loaded: io::Loaded, s: &Settings, kind: OutputKind, t_read: Instant) -> Result<Input> {
     let src_kind = loaded.info.format;
     let file_wrap = loaded.info.wrap;
-    let mut notes = load_notes(&loaded, s);
+    let (mut notes, data) = load_notes(&loaded, s, kind);
     let channel_names = loaded.info.channel_names.clone();
+    let one_d = loaded.info.one_d;
     let mut base = loaded.into_base();
-    let src = read_as(base.format(), s);
+    let src = read_as(base.format(), s, data);
     base = base.reinterpret(src)?;
     let read_s = t_read.elapsed().as_secs_f64();
     let (base, resized) = resize(base, s, s.wrap.or(file_wrap).unwrap_or_default())?;
@@ -659,6 +688,7 @@ fn read(loaded: io::Loaded, s: &Settings, t_read: Instant) -> Result<Input> {
         channel_names,
         notes,
         read_s,
+        one_d,
     })
 }
 
@@ -871,6 +901,27 @@ fn decoded_note(src: Format, out: Format) -> Option<Note> {
             "the sRGB-encoded input is stored decoded to linear light ({} levels hold linear \
              values)",
             out.channel_type.name()
+        ))
+    })
+}
+
+/// The note for sRGB-encoded integer codes an integer output cannot keep
+/// as sRGB (KTX2, DDS and OpenEXR have no 16-bit sRGB form): they are
+/// decoded to linear codes of the same type, which changes every value,
+/// so it is said, with the flag that keeps the codes.
+fn codes_decoded_note(src: Format, out: Format) -> Option<Note> {
+    (src.color_space == ColorSpace::Srgb
+        && !src.channel_type.is_float()
+        && out.color_space == ColorSpace::Linear
+        && !out.channel_type.is_float())
+    .then(|| {
+        Note::Text(format!(
+            "the output has no sRGB {} form: the sRGB-encoded {} codes are decoded to linear {} \
+             ({} linear keeps the stored codes, read as linear data)",
+            out.channel_type.name(),
+            src.channel_type.name(),
+            out.channel_type.name(),
+            crate::setting::Setting::Color
         ))
     })
 }

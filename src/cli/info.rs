@@ -169,6 +169,7 @@ fn kind_text(i: &io::SourceInfo) -> String {
         Some(io::Environment::Cube) => {
             "cube map (OpenEXR strip: six faces stacked, +x -x +y -y +z -z from the top)".into()
         }
+        None if i.one_d => i.kind.describe().replacen("2-D", "1-D", 1),
         None => i.kind.describe(),
     }
 }

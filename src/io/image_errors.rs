@@ -60,7 +60,10 @@ pub(super) fn image_error(format: FileFormat, limits: &Limits, e: image::ImageEr
 fn io_error(format: FileFormat, io: &std::io::Error) -> Error {
     match io.kind() {
         std::io::ErrorKind::UnexpectedEof => decode(format, "the file ends early: it is truncated"),
-        _ => decode(format, format!("cannot read the file: {io}")),
+        _ => decode(
+            format,
+            format!("cannot read the file: {}", crate::error::io_words(io)),
+        ),
     }
 }
 

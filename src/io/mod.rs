@@ -145,6 +145,10 @@ pub struct SourceInfo {
     /// [`EnvironmentMaps`]); a lat-long OpenEXR stays `Plain` here and is
     /// told by [`SourceInfo::environment`].
     pub kind: crate::texture::ImageKind,
+    /// A 1-D texture or 1-D array (KTX2 `pixelHeight` 0, DDS
+    /// `TEXTURE1D`): its images are one row high, and a KTX2 output of
+    /// the same kind stays 1-D.
+    pub one_d: bool,
 }
 
 impl SourceInfo {
@@ -163,6 +167,7 @@ impl SourceInfo {
             environment: None,
             placement: crate::env::Placement::Centred,
             kind: crate::texture::ImageKind::Plain,
+            one_d: false,
         }
     }
 
@@ -806,6 +811,9 @@ pub struct SaveOptions {
     /// lat-long and cube maps, [`exr::edges_from_centred`]); `Edges` says
     /// they are placed as OpenEXR places them already.
     pub placement: crate::env::Placement,
+    /// Write a texture one row high as 1-D where the container has 1-D
+    /// textures (KTX2 `pixelHeight` 0); the source was 1-D.
+    pub one_d: bool,
 }
 
 /// The fingerprint stored in an existing output (EXR attribute or KTX2

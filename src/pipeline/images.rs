@@ -94,6 +94,7 @@ pub(super) fn process(
         notes: std::mem::take(&mut input.notes)
             .into_iter()
             .chain(super::decoded_note(src, out_format))
+            .chain(super::codes_decoded_note(src, out_format))
             .collect(),
         blocks: None,
         block_format: s.compress.map(|(bf, _)| block_label(bf, out_format)),
@@ -143,7 +144,8 @@ pub(super) fn process(
     };
     progress(Stage::Writing);
     let t_write = Instant::now();
-    let save = save_options(s, &plan, src, fingerprint, None);
+    let mut save = save_options(s, &plan, src, fingerprint, None);
+    save.one_d = input.one_d && source == target && images.iter().all(|l| l[0].height() == 1);
     let kept = kept_level0(job, source, target, input.placed, &images)?;
     write(
         job,
@@ -272,6 +274,8 @@ struct Images {
     file_wrap: Option<Wrap>,
     notes: Vec<Note>,
     read_s: f64,
+    /// The source is a 1-D texture or array (see [`io::SourceInfo::one_d`]).
+    one_d: bool,
 }
 
 /// Load (six face files) or interpret `loaded` as a [`Source`], and read
@@ -283,9 +287,10 @@ fn read(
     t_read: Instant,
 ) -> Result<(ImageKind, Images)> {
     let options = load_options(s);
-    let (source, mut notes, file_wrap) = match loaded {
+    let one_d = loaded.as_ref().is_some_and(|l| l.info.one_d);
+    let (source, (mut notes, data), file_wrap) = match loaded {
         Some(l) => {
-            let notes = load_notes(&l, s);
+            let notes = load_notes(&l, s, job.kind);
             let wrap = l.info.wrap;
             (source::interpret(l, &job.input, s.env.target)?, notes, wrap)
         }
@@ -295,7 +300,7 @@ fn read(
                 .iter()
                 .map(|f| io::load_with(f, &s.limits, &options))
                 .collect::<Result<Vec<_>>>()?;
-            let notes = load_notes(&faces[0], s);
+            let notes = load_notes(&faces[0], s, job.kind);
             (source::from_faces(faces, &job.faces)?, notes, None)
         }
     };
@@ -311,7 +316,7 @@ fn read(
     let wrap = image_wrap(kind, s, file_wrap);
     for mut levels in images {
         let base = levels.swap_remove(0);
-        let f = read_as(base.format(), s);
+        let f = read_as(base.format(), s, data);
         let mut base = base.reinterpret(f)?;
         if base.channel_type().is_float() {
             mip::nan::apply(&mut base, s.nan_policy)?;
@@ -340,6 +345,7 @@ fn read(
             file_wrap,
             notes,
             read_s,
+            one_d,
         },
     ))
 }

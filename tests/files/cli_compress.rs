@@ -372,7 +372,7 @@ fn a_batch_says_each_note_once_with_its_count() {
         })
         .collect();
     for (extra, phrase) in [
-        (vec![], "does not say how its values encode colour"),
+        (vec![], "a one-channel output holds data"),
         (vec!["--compress", "bc4"], "holds data"),
     ] {
         let out = dir.path().join(format!("out{}", extra.len()));
@@ -393,4 +393,75 @@ fn a_batch_says_each_note_once_with_its_count() {
             .filter(|l| l.contains("concerns 3 inputs in all"));
         assert_eq!(counted.count(), 1, "{err}");
     }
+}
+
+/// Not BC4 only: any one-channel output without `--color` holds data
+/// (roughness, height, masks), so an untagged grey PNG's codes reach an
+/// OpenEXR level 0 as code / 255, not decoded from sRGB, said once; and a
+/// batch of such files says it once with the count (issue 53).
+#[test]
+fn one_channel_outputs_keep_the_stored_codes_said_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n);
+    let codes = untagged_grey_png(&p("g.png"), 37, 23);
+    let o = parvo(&[
+        "mip",
+        p("g.png").to_str().unwrap(),
+        "-o",
+        p("g.exr").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&ok_output(&o)).to_string();
+    assert_eq!(
+        err.matches("a one-channel output holds data").count(),
+        1,
+        "{err}"
+    );
+    let loaded = parvo::io::load(p("g.exr").to_str().unwrap(), &Default::default()).unwrap();
+    let got = loaded.base().to_linear();
+    assert_eq!(got.len(), codes.len());
+    for (g, c) in got.iter().zip(&codes) {
+        // f16 holds code / 255 within half a unit in its last place.
+        assert!((g - *c as f32 / 255.0).abs() <= 5e-4, "{g} vs code {c}");
+    }
+    // `--color srgb` still decodes (a mid grey code is far below 0.5).
+    ok(&parvo(&[
+        "mip",
+        p("g.png").to_str().unwrap(),
+        "--color",
+        "srgb",
+        "-o",
+        p("s.exr").to_str().unwrap(),
+    ]));
+    let s = parvo::io::load(p("s.exr").to_str().unwrap(), &Default::default()).unwrap();
+    let diff = (s.base().to_linear().iter().zip(&got)).fold(0f32, |m, (a, b)| m.max((a - b).abs()));
+    assert!(diff > 0.1, "--color srgb decodes the codes: {diff}");
+    // A batch of three: the note once, with its count.
+    for n in ["b1.png", "b2.png", "b3.png"] {
+        untagged_grey_png(&p(n), 9, 7);
+    }
+    std::fs::create_dir(p("out")).unwrap();
+    let o = parvo(&[
+        "mip",
+        p("b1.png").to_str().unwrap(),
+        p("b2.png").to_str().unwrap(),
+        p("b3.png").to_str().unwrap(),
+        "--out-dir",
+        p("out").to_str().unwrap(),
+        "--ext",
+        "exr",
+    ]);
+    let err = String::from_utf8_lossy(&ok_output(&o)).to_string();
+    // The note, and the line that counts the inputs it concerns.
+    assert_eq!(
+        err.matches("a one-channel output holds data").count(),
+        2,
+        "{err}"
+    );
+    assert!(err.contains("concerns 3 inputs in all"), "{err}");
+}
+
+/// The stderr of a run that must have succeeded.
+fn ok_output(o: &Output) -> Vec<u8> {
+    ok(o);
+    o.stderr.clone()
 }

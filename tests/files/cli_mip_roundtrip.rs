@@ -146,7 +146,9 @@ fn srgb_png_becomes_linear_half_exr_filtered_in_linear_light() {
     let src = dir.path().join("g.png");
     image::save_buffer(&src, &[0, 255, 255, 0], 2, 2, image::ExtendedColorType::L8).unwrap();
     let out = dir.path().join("g.exr");
-    let r = parvo(&["mip", s(&src), "-o", s(&out)]);
+    // A one-channel file that does not say it is sRGB is data by default
+    // (issue 53): `--color srgb` says it is colour.
+    let r = parvo(&["mip", s(&src), "--color", "srgb", "-o", s(&out)]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let l = load(&out);
     assert_eq!(
@@ -158,7 +160,11 @@ fn srgb_png_becomes_linear_half_exr_filtered_in_linear_light() {
     assert_eq!(l.levels[1].to_linear(), [0.5]);
     // sRGB code 188 decodes to 0.5029 linear.
     image::save_buffer(&src, &[188], 1, 1, image::ExtendedColorType::L8).unwrap();
-    assert!(parvo(&["mip", s(&src), "-o", s(&out)]).status.success());
+    assert!(
+        parvo(&["mip", s(&src), "--color", "srgb", "-o", s(&out)])
+            .status
+            .success()
+    );
     let v = load(&out).base().to_linear()[0];
     assert!((v - 0.50289).abs() < 5e-4, "{v}");
     // --color linear keeps the codes as linear values.

@@ -180,3 +180,61 @@ fn premultiplied_alpha_sets_the_dfd_flag_and_reads_back() {
     let back = io::load(path.to_str().unwrap(), &io::Limits::default()).unwrap();
     assert_eq!(back.levels, levels);
 }
+
+/// A 1-D texture (KTX2 `pixelHeight` 0) is said as 1-D and stays 1-D:
+/// `parvo mip` of it writes `pixelHeight` 0 and a one-letter
+/// `KTXorientation` (KTX 2.0 sections 3.4 and 5.4), every level one row
+/// (issue 53: it was read as a 2-D texture of height 1 and written so).
+#[test]
+fn one_d_textures_stay_one_d() {
+    let dir = tempfile::tempdir().unwrap();
+    let w = 37u32;
+    let row = Texture::from_u8(
+        w,
+        1,
+        Format::new(4, ChannelType::U8, ColorSpace::Srgb),
+        noise(w as usize * 4, 0x1d),
+    )
+    .unwrap();
+    let mut bytes = write(&[row], &SaveOptions::default());
+    // pixelHeight (bytes 24..28) 0: the same level sizes, a 1-D texture.
+    assert_eq!(u32::from_le_bytes(bytes[24..28].try_into().unwrap()), 1);
+    bytes[24..28].copy_from_slice(&0u32.to_le_bytes());
+    let src = dir.path().join("row.ktx2");
+    std::fs::write(&src, &bytes).unwrap();
+    let loaded = parvo::io::load(src.to_str().unwrap(), &Default::default()).unwrap();
+    assert!(loaded.info.one_d);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_parvo"))
+        .args(["info", src.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let info = String::from_utf8_lossy(&o.stdout);
+    assert!(info.contains("kind:       1-D"), "{info}");
+    let out = dir.path().join("out.ktx2");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_parvo"))
+        .args(["mip", src.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let b = std::fs::read(&out).unwrap();
+    let r = ktx2::Reader::new(&b[..]).unwrap();
+    let h = r.header();
+    assert_eq!((h.pixel_width, h.pixel_height), (w, 0));
+    // 37 → 18 → 9 → 4 → 2 → 1: six levels, each one row.
+    assert_eq!(h.level_count, 6);
+    for (k, level) in r.levels().enumerate() {
+        let lw = (w >> k).max(1) as usize;
+        assert_eq!(level.data.len(), lw * 4, "level {k}");
+    }
+    let orientation = r
+        .key_value_data()
+        .find(|(k, _)| *k == "KTXorientation")
+        .map(|(_, v)| {
+            String::from_utf8_lossy(v)
+                .trim_end_matches('\0')
+                .to_string()
+        });
+    assert_eq!(orientation.as_deref(), Some("r"));
+    let back = parvo::io::load(out.to_str().unwrap(), &Default::default()).unwrap();
+    assert!(back.info.one_d);
+}

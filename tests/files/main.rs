@@ -24,6 +24,7 @@ mod cli_tradeoff;
 mod compress;
 mod env_containers;
 mod env_openexr_conventions;
+mod error_words;
 mod fuzz_replay;
 mod interrupted_write_leaves_destination;
 mod io_corrupt_inputs;

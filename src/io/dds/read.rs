@@ -729,14 +729,16 @@ pub(super) fn dds_kind(header: &Header) -> Result<ImageKind> {
     })
 }
 
+/// The refusal of a volume (3-D) texture.
+const VOLUME: &str = "volume (3-D) textures are not supported (parvo reads 2-D textures, arrays \
+     and cube maps): store its depth slices as the layers of a 2-D array texture first";
+
 /// The kinds of DDS file parvo does not read (volumes, buffers), refused
 /// in words before any texel is read.
 pub(super) fn refuse_unsupported(header: &Header) -> Result<()> {
     let h = header.height;
     if header.caps2 & caps::VOLUME != 0 || (header.flags & ddsd::DEPTH != 0 && header.depth > 1) {
-        return Err(decode_err(
-            "volume textures are not supported (parvo reads 2-D textures)",
-        ));
+        return Err(decode_err(VOLUME));
     }
     if let Some(d) = &header.dx10 {
         match d.resource_dimension {
@@ -752,9 +754,7 @@ pub(super) fn refuse_unsupported(header: &Header) -> Result<()> {
                 )));
             }
             4 => {
-                return Err(decode_err(
-                    "volume textures are not supported (parvo reads 2-D textures)",
-                ));
+                return Err(decode_err(VOLUME));
             }
             1 => {
                 return Err(decode_err(
@@ -878,6 +878,8 @@ pub fn load_with(path: &Path, limits: &Limits, options: &crate::io::LoadOptions)
     }
     info.attributes.sort();
     info.kind = kind;
+    // DX10's TEXTURE1D (2): one row, said as 1-D.
+    info.one_d = header.dx10.is_some_and(|d| d.resource_dimension == 2);
     Ok(Loaded {
         levels,
         info,

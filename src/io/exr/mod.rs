@@ -182,6 +182,55 @@ fn decode_err(e: impl fmt::Display) -> Error {
     }
 }
 
+/// An error of the `exr` crate while reading, in parvo's words: what is
+/// wrong in OpenEXR's terms, never the crate's phrase alone.
+fn read_err(e: ::exr::error::Error) -> Error {
+    use ::exr::error::Error as E;
+    decode_err(match e {
+        E::Invalid(m) => match &*m {
+            "reference to missing bytes" | "not enough data" => {
+                "the file ends before the data its header and offset table point to: it is \
+                 truncated"
+                    .to_string()
+            }
+            "file identifier missing" => "not an OpenEXR file (its magic number is wrong)".into(),
+            m if m.contains("file feature flags") => {
+                "its version field sets feature flags OpenEXR does not define: the file is \
+                 corrupt or from a newer OpenEXR"
+                    .into()
+            }
+            // The crate's phrases name what is wrong ("text too long",
+            // "block position 9 exceeds total size 4") or the part that
+            // is ("block type attribute value").
+            m if ["invalid", "exceed", "too ", "missing", "must"]
+                .iter()
+                .any(|w| m.contains(w)) =>
+            {
+                format!("the file is corrupt ({m})")
+            }
+            m => format!("the file is corrupt: its {m} is invalid"),
+        },
+        E::NotSupported(m) if m.contains("subsampl") => SUBSAMPLED.into(),
+        E::NotSupported(m) if m.contains("deep") => DEEP.into(),
+        E::NotSupported(m) => format!("the file uses an OpenEXR feature parvo does not read ({m})"),
+        E::Io(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+            "the file ends early: it is truncated".into()
+        }
+        E::Io(e) => format!("cannot read the file: {}", crate::error::io_words(&e)),
+        E::Aborted => "reading was stopped".into(),
+    })
+}
+
+/// The refusal of chroma-subsampled channels (OpenEXR's luminance/chroma
+/// images: Y, RY, BY).
+const SUBSAMPLED: &str = "its channels are subsampled (a luminance/chroma image: Y, RY and BY, as \
+     OpenEXR's RGBA interface writes them), which parvo does not read: convert it to full-\
+     resolution RGB or RGBA first";
+
+/// The refusal of deep data.
+const DEEP: &str = "deep (several samples per pixel) OpenEXR data is not a texture parvo reads: \
+     flatten it to RGBA first";
+
 fn encode_err(e: impl fmt::Display) -> Error {
     Error::Encode {
         format: "OpenEXR",

@@ -214,7 +214,7 @@ pub(super) type Part =
 /// not the display window is placed in the display window, black outside
 /// (as maketx pads it), what lies outside is cropped, and a note says so.
 pub fn load(path: &Path, limits: &Limits, options: &crate::io::LoadOptions) -> Result<Loaded> {
-    let meta = MetaData::read_from_file(path, false).map_err(decode_err)?;
+    let meta = MetaData::read_from_file(path, false).map_err(read_err)?;
     let parts = meta.headers.len();
     let part = options.subimage;
     let header = meta.headers.get(part).ok_or_else(|| {
@@ -225,7 +225,10 @@ pub fn load(path: &Path, limits: &Limits, options: &crate::io::LoadOptions) -> R
         ))
     })?;
     if header.deep {
-        return Err(decode_err("deep data is not a texture"));
+        return Err(decode_err(DEEP));
+    }
+    if (header.channels.list.iter()).any(|c| c.sampling != ::exr::math::Vec2(1, 1)) {
+        return Err(decode_err(SUBSAMPLED));
     }
     let mut notes = Vec::new();
     if parts > 1 {
@@ -314,6 +317,7 @@ pub fn load(path: &Path, limits: &Limits, options: &crate::io::LoadOptions) -> R
         },
         // A cube-face environment stays one strip image here
         // (`environment` says what it is).
+        one_d: false,
         kind: crate::texture::ImageKind::Plain,
     };
     Ok(Loaded::plain(levels, info))
@@ -520,14 +524,14 @@ pub(super) fn read_part(path: &Path, part: usize) -> Result<Part> {
             .first_valid_layer()
             .all_attributes()
             .from_file(path)
-            .map_err(decode_err)?
+            .map_err(read_err)?
             .layer_data);
     }
     let mut layers = reader
         .all_layers()
         .all_attributes()
         .from_file(path)
-        .map_err(decode_err)?
+        .map_err(read_err)?
         .layer_data;
     if part >= layers.len() {
         return Err(decode_err(format!("part {part} has no readable pixels")));

@@ -276,6 +276,7 @@ pub(super) fn load_bytes(
     info.wrap = wrap;
     info.attributes = attributes;
     info.kind = kind;
+    info.one_d = h.pixel_height == 0;
     Ok(Loaded {
         levels,
         info,

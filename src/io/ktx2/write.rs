@@ -198,9 +198,15 @@ pub(super) fn write_payloads(
 ) -> Result<()> {
     use rayon::prelude::*;
     let n = payloads.len() as u64;
+    // A 1-D texture has pixelHeight 0 and a one-letter orientation (KTX
+    // 2.0 sections 3.4 and 5.4).
+    let one_d = opts.one_d && shape.height == 1;
     let mut kv = Vec::new();
     let mut entries: Vec<(String, String)> = vec![
-        ("KTXorientation".into(), "rd".into()),
+        (
+            "KTXorientation".into(),
+            if one_d { "r" } else { "rd" }.into(),
+        ),
         (
             "KTXwriter".into(),
             concat!("parvo ", env!("CARGO_PKG_VERSION")).into(),
@@ -258,7 +264,7 @@ pub(super) fn write_payloads(
         desc.vk,
         desc.type_size,
         shape.width,
-        shape.height,
+        if one_d { 0 } else { shape.height },
         0,
         shape.layers,
         shape.faces,

@@ -41,7 +41,15 @@ pub(super) fn words(
             std::io::ErrorKind::InvalidData | std::io::ErrorKind::InvalidInput => {
                 compressed_corrupt(raw, l, &io.to_string())
             }
-            _ => decode_err(format!("cannot read the file: {io}")),
+            // A decompressor's failure passed on as an I/O error with
+            // no reason of its own ("Decode Error").
+            std::io::ErrorKind::Other if io.to_string() == "Decode Error" => {
+                compressed_corrupt(raw, l, "its decoder stops inside it")
+            }
+            _ => decode_err(format!(
+                "cannot read the file: {}",
+                crate::error::io_words(&io)
+            )),
         },
         TiffError::IntSizeError => {
             corrupt("a size or offset in the file is larger than this machine can address".into())
@@ -200,7 +208,16 @@ fn unsupported(u: TiffUnsupportedError, raw: Option<&chain::Dir>, l: &chain::Lay
         U::UnsupportedSampleDepth(b) | U::UnsupportedBitsPerChannel(b) => {
             format!("{b}-bit samples are not supported")
         }
-        U::UnsupportedSampleFormat(_) => "this sample format is not supported".into(),
+        U::UnsupportedSampleFormat(_) => {
+            match raw.and_then(|r| r.unsigned(l, tag::SAMPLE_FORMAT)) {
+                Some(f) => format!(
+                    "SampleFormat {f} is not supported (1 unsigned and 2 signed integers, 3 floats are)"
+                ),
+                None => "its SampleFormat is not supported (1 unsigned and 2 signed integers, 3 \
+                     floats are)"
+                    .into(),
+            }
+        }
         U::UnsupportedColorType(_) => {
             "this combination of channels and bit depth is not supported".into()
         }

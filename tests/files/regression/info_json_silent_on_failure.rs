@@ -46,8 +46,10 @@ fn opaque_rgb_and_grey_dds_record_alpha_mode_opaque() {
         };
         image::save_buffer(&p, &px, 4, 4, ty).unwrap();
         let out = dir.path().join(name);
-        // 8-bit PNG is sRGB: stored as R8G8B8A8_UNORM_SRGB, alpha 255.
-        ok(&parvo(&["mip", s(&p), "-o", s(&out)]));
+        // 8-bit PNG said to be sRGB: stored as R8G8B8A8_UNORM_SRGB, alpha
+        // 255 (an untagged grey file is data by default since issue 53,
+        // stored as R8).
+        ok(&parvo(&["mip", s(&p), "--color", "srgb", "-o", s(&out)]));
         let b = std::fs::read(&out).unwrap();
         let word = |i: usize| u32::from_le_bytes(b[i * 4..i * 4 + 4].try_into().unwrap());
         assert_eq!(word(32), 29, "{name}: DXGI R8G8B8A8_UNORM_SRGB");

@@ -78,7 +78,7 @@ fn other_resource_dimensions_are_named() {
     let bc1 = std::fs::read(peer("pillow_bc1.dds")).unwrap();
     let dir = tempfile::tempdir().unwrap();
     for (dim, want) in [
-        (4u32, Some("volume textures are not supported")),
+        (4u32, Some("volume (3-D) textures are not supported")),
         (1, Some("a buffer, not a texture")),
         (9, Some("resource dimension is 9")),
         (2, Some("1-D texture, but the height is 256")),
