@@ -100,19 +100,33 @@ impl Walk {
             self.problems
                 .push(format!("{what}: {}: {line}", found.join("; ")));
         }
-        let general: String = text
-            .chars()
-            .map(|c| if c.is_ascii_digit() { '#' } else { c })
-            .collect();
-        let mut general = general;
-        while general.contains("##") {
-            general = general.replace("##", "#");
-        }
         self.messages
-            .entry(general.replace('#', "N"))
+            .entry(numbers_as_n(&text))
             .or_default()
             .push(what.to_string());
     }
+}
+
+/// `text` with each number that stands on its own (not inside a name such
+/// as KTX2 or BC7) written N, so messages that differ only in numbers
+/// are one.
+fn numbers_as_n(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut prev: Option<char> = None;
+    let mut in_number = false;
+    for c in text.chars() {
+        let starts =
+            c.is_ascii_digit() && !prev.is_some_and(|p| p.is_ascii_alphanumeric() || p == '_');
+        if starts {
+            in_number = true;
+            out.push('N');
+        } else if !(in_number && (c.is_ascii_digit() || c == '.')) {
+            in_number = false;
+            out.push(c);
+        }
+        prev = Some(c);
+    }
+    out
 }
 
 fn manifest() -> Vec<serde_json::Value> {
